@@ -1,0 +1,12 @@
+# Every dependency comes from Debian (scripts/setup installs them) and is found here, once.
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+find_package(OpenMP REQUIRED COMPONENTS CXX)
+find_package(HDF5 REQUIRED COMPONENTS C CXX)
+find_package(nlohmann_json 3 REQUIRED)
+find_package(CLI11 REQUIRED)
+if(SPH_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()
+if(SPH_BUILD_BENCH)
+  find_package(benchmark REQUIRED)
+endif()

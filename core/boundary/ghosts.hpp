@@ -1,0 +1,113 @@
+#pragma once
+// Ghost particles (section 2.4): every fluid particle within 2 h_i of a wall is mirrored across it, and a
+// particle near two perpendicular walls (a corner) also gets the doubly reflected ghost. Ghosts copy
+// mass, density, pressure and smoothing length; their velocity is reflected (free-slip: normal part
+// reversed) or reversed (no-slip). They are rebuilt from scratch each step by one stream expansion
+// through the store's registry (old ghosts dropped, new ones written right after their source), so the
+// result is deterministic at any thread count.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/boundary/wall.hpp"
+#include "core/particle_store.hpp"
+#include "parallel/compaction.hpp"
+
+namespace sph {
+
+enum class GhostSlip { free_slip, no_slip };
+
+class GhostBuilder {
+ public:
+  /// Up to two walls and one corner per particle (the container's corners).
+  static constexpr int kMaxGhosts = 3;
+
+  GhostBuilder(std::vector<Wall2> walls, GhostSlip slip) : walls_(std::move(walls)), slip_(slip) {}
+
+  const std::vector<Wall2>& walls() const { return walls_; }
+  GhostSlip slip() const { return slip_; }
+
+  /// The ghost images of a particle at x with smoothing length h: positions and velocities.
+  struct Images {
+    int count = 0;
+    std::array<Vec<2>, kMaxGhosts> x;
+    std::array<Vec<2>, kMaxGhosts> v;
+  };
+
+  Images images(const Vec<2>& x, const Vec<2>& v, double h) const {
+    Images out;
+    std::array<int, 2> near{-1, -1};
+    int nnear = 0;
+    const double reach = 2.0 * h;
+    for (int w = 0; w < static_cast<int>(walls_.size()) && nnear < 2; ++w) {
+      const Wall2& wall = walls_[static_cast<std::size_t>(w)];
+      const double dist = wall.signed_distance(x);
+      if (dist < 0.0 || dist >= reach || !wall.projects_onto(x)) continue;
+      near[static_cast<std::size_t>(nnear++)] = w;
+      out.x[static_cast<std::size_t>(out.count)] = wall.reflect_point(x);
+      out.v[static_cast<std::size_t>(out.count)] = ghost_velocity(v, wall, nullptr);
+      ++out.count;
+    }
+    if (nnear == 2) {
+      const Wall2& a = walls_[static_cast<std::size_t>(near[0])];
+      const Wall2& b = walls_[static_cast<std::size_t>(near[1])];
+      if (std::abs(a.n.dot(b.n)) < 1e-12) {
+        out.x[static_cast<std::size_t>(out.count)] = b.reflect_point(a.reflect_point(x));
+        out.v[static_cast<std::size_t>(out.count)] = ghost_velocity(v, a, &b);
+        ++out.count;
+      }
+    }
+    return out;
+  }
+
+  /// Drops the old ghosts and writes the new ones right after their source particle.
+  void rebuild(ParticleStore<2>& store) const {
+    std::vector<std::uint32_t> offsets;
+    const auto view = store.view();
+    const std::vector<std::uint32_t> src = par::expansion_map(
+        store.size(),
+        [&](std::size_t i) -> std::uint32_t {
+          if (view.kind[i] == Kind::ghost) return 0;
+          if (view.kind[i] != Kind::fluid) return 1;
+          return 1u + static_cast<std::uint32_t>(images(view.x[i], view.v[i], view.h[i]).count);
+        },
+        &offsets);
+    // Source positions/velocities are needed after the gather overwrote them: read from a copy of view
+    // data through src (the first output of each source is its own copy).
+    store.gather(src);
+    auto s = store.view();
+    par::parallel_for(offsets.size() - 1, [&](std::size_t i) {
+      const std::uint32_t first = offsets[i];
+      const std::uint32_t count = offsets[i + 1] - first;
+      if (count <= 1) return;
+      const Images im = images(s.x[first], s.v[first], s.h[first]);
+      for (int g = 0; g < im.count; ++g) {
+        const std::size_t k = first + 1 + static_cast<std::size_t>(g);
+        s.x[k] = im.x[static_cast<std::size_t>(g)];
+        s.v[k] = im.v[static_cast<std::size_t>(g)];
+        s.kind[k] = Kind::ghost;
+        s.a[k].setZero();
+        s.drho[k] = 0.0;
+      }
+    });
+  }
+
+  /// Removes every ghost (before output, refinement or checkpoints).
+  static void remove(ParticleStore<2>& store) {
+    const auto view = store.view();
+    store.compact([&](std::size_t i) { return view.kind[i] != Kind::ghost; });
+  }
+
+ private:
+  Vec<2> ghost_velocity(const Vec<2>& v, const Wall2& a, const Wall2* b) const {
+    if (slip_ == GhostSlip::no_slip) return -v;
+    Vec<2> g = a.reflect_vector(v);
+    if (b) g = b->reflect_vector(g);
+    return g;
+  }
+
+  std::vector<Wall2> walls_;
+  GhostSlip slip_;
+};
+
+}  // namespace sph

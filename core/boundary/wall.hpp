@@ -1,0 +1,89 @@
+#pragma once
+// Solid walls as straight segments with a unit normal pointing into the fluid (section 2.4).
+// Axis-aligned now (the container and rectangular obstacles); nothing here assumes it except the
+// helpers that build them, so a sloped segment can come later.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "core/types.hpp"
+
+namespace sph {
+
+struct Wall2 {
+  Vec<2> p0, p1;  // end points
+  Vec<2> n;       // unit normal, pointing into the fluid
+
+  Vec<2> tangent() const { return (p1 - p0).normalized(); }
+  double length() const { return (p1 - p0).norm(); }
+  /// Signed distance of x from the wall's line, positive on the fluid side.
+  double signed_distance(const Vec<2>& x) const { return (x - p0).dot(n); }
+  /// Position of x's projection along the segment, 0 at p0 and length() at p1.
+  double along(const Vec<2>& x) const { return (x - p0).dot(tangent()); }
+  bool projects_onto(const Vec<2>& x, double margin = 0.0) const {
+    const double s = along(x);
+    return s >= -margin && s <= length() + margin;
+  }
+  Vec<2> reflect_point(const Vec<2>& x) const { return x - 2.0 * signed_distance(x) * n; }
+  Vec<2> reflect_vector(const Vec<2>& v) const { return v - 2.0 * v.dot(n) * n; }
+};
+
+/// Axis-aligned rectangle [lo, hi].
+struct Box2 {
+  Vec<2> lo, hi;
+  bool contains(const Vec<2>& x) const {
+    return x[0] >= lo[0] && x[0] <= hi[0] && x[1] >= lo[1] && x[1] <= hi[1];
+  }
+  bool contains_strictly(const Vec<2>& x) const {
+    return x[0] > lo[0] && x[0] < hi[0] && x[1] > lo[1] && x[1] < hi[1];
+  }
+};
+
+/// The solid geometry of a scene: a container (fluid inside, open at the top if `open_top`) and
+/// rectangular obstacles (fluid outside).
+struct Geometry2 {
+  Box2 container{Vec<2>(0, 0), Vec<2>(1, 1)};
+  bool open_top = true;
+  std::vector<Box2> obstacles;
+
+  /// Every wall segment with its normal into the fluid.
+  std::vector<Wall2> walls() const {
+    std::vector<Wall2> w;
+    const Vec<2> lo = container.lo, hi = container.hi;
+    w.push_back({Vec<2>(lo[0], lo[1]), Vec<2>(hi[0], lo[1]), Vec<2>(0, 1)});   // bottom
+    w.push_back({Vec<2>(lo[0], lo[1]), Vec<2>(lo[0], hi[1]), Vec<2>(1, 0)});   // left
+    w.push_back({Vec<2>(hi[0], lo[1]), Vec<2>(hi[0], hi[1]), Vec<2>(-1, 0)});  // right
+    if (!open_top) w.push_back({Vec<2>(lo[0], hi[1]), Vec<2>(hi[0], hi[1]), Vec<2>(0, -1)});
+    for (const Box2& b : obstacles) {
+      w.push_back({Vec<2>(b.lo[0], b.hi[1]), Vec<2>(b.hi[0], b.hi[1]), Vec<2>(0, 1)});   // top face
+      w.push_back({Vec<2>(b.lo[0], b.lo[1]), Vec<2>(b.hi[0], b.lo[1]), Vec<2>(0, -1)});  // bottom face
+      w.push_back({Vec<2>(b.lo[0], b.lo[1]), Vec<2>(b.lo[0], b.hi[1]), Vec<2>(-1, 0)});  // left face
+      w.push_back({Vec<2>(b.hi[0], b.lo[1]), Vec<2>(b.hi[0], b.hi[1]), Vec<2>(1, 0)});   // right face
+    }
+    return w;
+  }
+
+  /// True when x is in the fluid domain: inside the container (above its top too when open) and outside
+  /// every obstacle.
+  bool in_fluid_domain(const Vec<2>& x) const {
+    if (x[0] < container.lo[0] || x[0] > container.hi[0] || x[1] < container.lo[1]) return false;
+    if (!open_top && x[1] > container.hi[1]) return false;
+    for (const Box2& b : obstacles) {
+      if (b.contains_strictly(x)) return false;
+    }
+    return true;
+  }
+
+  /// Distance from x to the nearest wall segment (for daughters near walls).
+  double distance_to_walls(const Vec<2>& x) const {
+    double best = std::numeric_limits<double>::infinity();
+    for (const Wall2& w : walls()) {
+      const double s = std::clamp(w.along(x), 0.0, w.length());
+      best = std::min(best, (x - (w.p0 + s * w.tangent())).norm());
+    }
+    return best;
+  }
+};
+
+}  // namespace sph

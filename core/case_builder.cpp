@@ -1,0 +1,81 @@
+#include "core/case_builder.hpp"
+
+#include <cmath>
+
+#include "core/boundary/wall_particles.hpp"
+#include "core/setup.hpp"
+
+namespace sph {
+
+namespace {
+
+constexpr double kG = 9.81;
+
+void add_lattice(Simulation& sim, const std::vector<Vec<2>>& pts, double spacing, double h_factor, int level,
+                 const Vec<2>& velocity) {
+  FluidBlockSpec block;
+  block.spacing = spacing;
+  block.h_factor = h_factor;
+  block.level = level;
+  block.velocity = velocity;
+  add_fluid(sim.store(), pts, block, sim.settings().eos.rho0);
+}
+
+double level_spacing(double d0, int level) { return d0 / std::pow(2.0, level); }
+
+}  // namespace
+
+Simulation make_still_tank(const TankSpec& spec) {
+  SolverSettings s;
+  s.eos.rho0 = 1000.0;
+  s.eos.c0 = spec.mach_factor * std::sqrt(kG * spec.depth);
+  s.geometry.container = {Vec<2>(0, 0), Vec<2>(spec.width, 2.0 * spec.depth)};
+  if (spec.lennard_jones) s.lennard_jones = LennardJonesSettings{5.0 * kG * spec.depth, 0.5, spec.spacing / 2};
+  Simulation sim(s);
+  add_lattice(sim, lattice_rectangle(Vec<2>(0, 0), Vec<2>(spec.width, spec.depth), spec.spacing), spec.spacing,
+              spec.h_factor, 0, Vec<2>::Zero());
+  set_hydrostatic(sim.store(), 0, sim.store().size(), spec.depth, kG, s.eos);
+  if (spec.lennard_jones) add_wall_particles(sim.store(), s.geometry.walls(), spec.spacing / 2, s.eos.rho0);
+  sim.refresh();
+  return sim;
+}
+
+Simulation make_dam_break(const DamBreakSpec& spec) {
+  SolverSettings s;
+  s.eos.rho0 = 1000.0;
+  s.eos.c0 = spec.mach_factor * std::sqrt(2.0 * kG * spec.column_height);
+  s.geometry.container = {Vec<2>(0, 0), Vec<2>(spec.tank_width, spec.tank_height)};
+  if (!spec.viscosity) s.viscosity.reset();
+  if (!spec.ghosts) s.ghosts.reset();
+  const double d = level_spacing(spec.spacing, spec.initial_level);
+  if (spec.lennard_jones) s.lennard_jones = LennardJonesSettings{5.0 * kG * spec.column_height, 0.5, d / 2};
+  Simulation sim(s);
+  add_lattice(sim, lattice_rectangle(Vec<2>(0, 0), Vec<2>(spec.column_width, spec.column_height), d),
+              d, spec.h_factor, spec.initial_level, Vec<2>::Zero());
+  set_hydrostatic(sim.store(), 0, sim.store().size(), spec.column_height, kG, s.eos);
+  if (spec.lennard_jones) add_wall_particles(sim.store(), s.geometry.walls(), d / 2, s.eos.rho0);
+  sim.refresh();
+  return sim;
+}
+
+Simulation make_drop(const DropSpec& spec) {
+  SolverSettings s;
+  s.eos.rho0 = 1000.0;
+  s.eos.c0 = spec.mach_factor * std::sqrt(kG * spec.depth);
+  const double half = 0.5 * spec.width;
+  s.geometry.container = {Vec<2>(-half, 0), Vec<2>(half, 2.0 * spec.depth)};
+  const double d = level_spacing(spec.spacing, spec.initial_level);
+  if (spec.lennard_jones) s.lennard_jones = LennardJonesSettings{5.0 * kG * spec.depth, 0.5, d / 2};
+  Simulation sim(s);
+  add_lattice(sim, lattice_rectangle(Vec<2>(-half, 0), Vec<2>(half, spec.depth), d), d, spec.h_factor,
+              spec.initial_level, Vec<2>::Zero());
+  const std::size_t pool = sim.store().size();
+  set_hydrostatic(sim.store(), 0, pool, spec.depth, kG, s.eos);
+  add_lattice(sim, lattice_circle(spec.centre, spec.radius, d), d, spec.h_factor, spec.initial_level,
+              Vec<2>(0.0, -spec.drop_speed));
+  if (spec.lennard_jones) add_wall_particles(sim.store(), s.geometry.walls(), d / 2, s.eos.rho0);
+  sim.refresh();
+  return sim;
+}
+
+}  // namespace sph

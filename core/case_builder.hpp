@@ -1,0 +1,53 @@
+#pragma once
+// Programmatic set-up of the paper's cases and of simple test scenes (PHYSICS.md, "The paper's cases").
+// Each builder returns a ready Simulation (rates evaluated, dt set).
+#include <memory>
+
+#include "core/simulation.hpp"
+
+namespace sph {
+
+struct TankSpec {
+  double width = 25.0;
+  double depth = 10.0;
+  double spacing = 25.0 / 30.0;
+  double h_factor = 1.2;
+  double mach_factor = 10.0;  // c0 = mach_factor * sqrt(g depth)
+  bool lennard_jones = false;
+};
+
+struct DamBreakSpec {
+  double column_width = 25.0;
+  double column_height = 25.0;
+  double tank_width = 50.0;   // the obstacle at x = 50 m is the container's right wall
+  double tank_height = 40.0;  // walls reach this high (open top)
+  double spacing = 25.0 / 30.0;
+  double h_factor = 1.2;
+  double mach_factor = 10.0;  // c0 = mach_factor * sqrt(2 g H0)
+  int initial_level = 0;      // 1: the fully refined lattice (spacing/2)
+  bool lennard_jones = true;
+  bool ghosts = true;
+  bool viscosity = true;
+};
+
+struct DropSpec {
+  double width = 25.0;  // container x in [-width/2, width/2]
+  double depth = 10.0;
+  double radius = 2.0;
+  Vec<2> centre = Vec<2>(0.0, 13.3);
+  double drop_speed = 2.0;
+  double spacing = 25.0 / 30.0;
+  double h_factor = 1.2;
+  double mach_factor = 10.0;  // c0 = mach_factor * sqrt(g depth) (a few times the impact speed)
+  int initial_level = 0;
+  bool lennard_jones = true;
+};
+
+/// Still water in a closed-sided open tank (hydrostatic start), ghost walls (free-slip).
+Simulation make_still_tank(const TankSpec& spec);
+/// The paper's breaking dam: square column against the left wall, gravity, free-slip walls.
+Simulation make_dam_break(const DamBreakSpec& spec);
+/// The paper's splash of a drop into a pool.
+Simulation make_drop(const DropSpec& spec);
+
+}  // namespace sph

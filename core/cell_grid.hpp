@@ -1,0 +1,158 @@
+#pragma once
+// Uniform cell grid over the particles' bounding box. Built by count -> exclusive scan -> stable scatter
+// (a parallel counting sort by cell); the caller reorders the store by `order()` so that each cell's
+// particles, and the runs of cells along x, are contiguous in memory.
+//
+// Neighbour traversal visits, for particle i, every j != i with r_ij < 2 h_ij = h_i + h_j, in a fixed
+// order (cells in lexicographic order, particles in store order): deterministic at any thread count.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include "core/types.hpp"
+#include "parallel/counting_sort.hpp"
+#include "parallel/parallel_for.hpp"
+
+namespace sph {
+
+template <int D>
+class CellGrid {
+ public:
+  using VecD = Vec<D>;
+  /// Upper bound on the number of cells; past it the cell size grows (sparse, far-flung particles).
+  static constexpr std::size_t kMaxCells = std::size_t{1} << 26;
+
+  /// Sorts particles into cells of size >= `min_cell_size` (give 2 max(h)). After this call, the store
+  /// must be gathered through order() before cell ranges refer to it.
+  void build(const VecD* x, std::size_t n, double min_cell_size) {
+    if (!(min_cell_size > 0.0) || !std::isfinite(min_cell_size)) {
+      throw std::invalid_argument("CellGrid::build: cell size must be positive and finite");
+    }
+    n_ = n;
+    struct Box {
+      VecD lo, hi;
+    };
+    const double inf = std::numeric_limits<double>::infinity();
+    Box init{VecD::Constant(inf), VecD::Constant(-inf)};
+    Box box = par::reduce(
+        n, init, [&](std::size_t i) { return Box{x[i], x[i]}; },
+        [](const Box& a, const Box& b) { return Box{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)}; });
+    if (n == 0) box = Box{VecD::Zero(), VecD::Zero()};
+    for (int k = 0; k < D; ++k) {
+      if (!std::isfinite(box.lo[k]) || !std::isfinite(box.hi[k])) {
+        throw std::runtime_error("CellGrid::build: a particle position is not finite");
+      }
+    }
+    cell_size_ = min_cell_size;
+    for (;;) {
+      std::size_t total = 1;
+      for (int k = 0; k < D; ++k) {
+        dims_[k] = static_cast<std::int64_t>(std::floor((box.hi[k] - box.lo[k]) / cell_size_)) + 1;
+        total *= static_cast<std::size_t>(dims_[k]);
+      }
+      if (total <= kMaxCells) {
+        cells_ = total;
+        break;
+      }
+      cell_size_ *= 2.0;
+    }
+    origin_ = box.lo;
+    inv_cell_ = 1.0 / cell_size_;
+    par::counting_sort(n, cells_, [&](std::size_t i) { return cell_of(x[i]); }, sorted_, scratch_);
+  }
+
+  /// Source index (in the store before reordering) of the k-th particle in cell order.
+  const std::vector<std::uint32_t>& order() const { return sorted_.order; }
+  /// cell_start()[c] .. cell_start()[c+1]: particles of cell c (after reordering).
+  const std::vector<std::uint32_t>& cell_start() const { return sorted_.bucket_start; }
+
+  std::size_t cell_count() const { return cells_; }
+  double cell_size() const { return cell_size_; }
+  const std::array<std::int64_t, D>& dims() const { return dims_; }
+  const VecD& origin() const { return origin_; }
+  std::size_t particle_count() const { return n_; }
+
+  std::array<std::int64_t, D> coords(const VecD& p) const {
+    std::array<std::int64_t, D> c{};
+    for (int k = 0; k < D; ++k) {
+      auto ck = static_cast<std::int64_t>((p[k] - origin_[k]) * inv_cell_);
+      c[k] = std::clamp<std::int64_t>(ck, 0, dims_[k] - 1);
+    }
+    return c;
+  }
+
+  std::size_t linear(const std::array<std::int64_t, D>& c) const {
+    std::size_t idx = 0;
+    for (int k = D - 1; k >= 0; --k) idx = idx * static_cast<std::size_t>(dims_[k]) + static_cast<std::size_t>(c[k]);
+    return idx;
+  }
+
+  std::size_t cell_of(const VecD& p) const { return linear(coords(p)); }
+
+  /// Calls f(begin, end) for each contiguous run of candidate particles around point p (the 3^D
+  /// neighbouring cells; along x three cells form one run). Runs come in a fixed order.
+  template <class F>
+  void for_each_candidate_run(const VecD& p, F&& f) const {
+    const auto c = coords(p);
+    const std::int64_t x0 = std::max<std::int64_t>(c[0] - 1, 0);
+    const std::int64_t x1 = std::min<std::int64_t>(c[0] + 1, dims_[0] - 1);
+    const auto& start = sorted_.bucket_start;
+    if constexpr (D == 1) {
+      f(start[static_cast<std::size_t>(x0)], start[static_cast<std::size_t>(x1) + 1]);
+    } else {
+      std::array<std::int64_t, D> q = c;
+      // Iterate over the outer coordinates (1..D-1) in lexicographic order, offsets -1..1.
+      std::array<std::int64_t, D> off{};
+      for (int k = 1; k < D; ++k) off[k] = -1;
+      for (;;) {
+        bool inside = true;
+        for (int k = 1; k < D; ++k) {
+          q[k] = c[k] + off[k];
+          if (q[k] < 0 || q[k] >= dims_[k]) inside = false;
+        }
+        if (inside) {
+          q[0] = x0;
+          const std::size_t first = linear(q);
+          const std::size_t last = first + static_cast<std::size_t>(x1 - x0);
+          f(start[first], start[last + 1]);
+        }
+        int k = D - 1;
+        while (k >= 1 && off[k] == 1) off[k--] = -1;
+        if (k < 1) break;
+        ++off[k];
+      }
+    }
+  }
+
+  /// Calls f(j, r2) for every j != i with |x_i - x_j| < h_i + h_j (= 2 h_ij), in a fixed order.
+  template <class F>
+  void for_each_neighbour(std::size_t i, const VecD* x, const double* h, F&& f) const {
+    const VecD xi = x[i];
+    const double hi = h[i];
+    for_each_candidate_run(xi, [&](std::uint32_t b, std::uint32_t e) {
+      for (std::uint32_t j = b; j < e; ++j) {
+        if (j == i) continue;
+        const double r2 = (xi - x[j]).squaredNorm();
+        const double support = hi + h[j];
+        if (r2 < support * support) f(j, r2);
+      }
+    });
+  }
+
+ private:
+  std::size_t n_ = 0;
+  std::size_t cells_ = 0;
+  double cell_size_ = 1.0;
+  double inv_cell_ = 1.0;
+  VecD origin_ = VecD::Zero();
+  std::array<std::int64_t, D> dims_{};
+  par::CountingSortResult sorted_;
+  std::vector<std::uint32_t> scratch_;
+};
+
+}  // namespace sph

@@ -1,0 +1,36 @@
+#pragma once
+// The geometry of one interacting pair (i, j), computed once by the sweep and shared by every effect.
+#include <cstddef>
+
+#include "core/particle_store.hpp"
+#include "core/types.hpp"
+
+namespace sph {
+
+template <int D>
+struct Pair {
+  std::size_t i = 0, j = 0;
+  Vec<D> xij = Vec<D>::Zero();  // x_i - x_j
+  Vec<D> vij = Vec<D>::Zero();  // v_i - v_j
+  double r2 = 0;   // |x_ij|^2
+  double r = 0;    // |x_ij|
+  double hij = 0;  // (h_i + h_j) / 2, section 2.3
+  double vx = 0;   // v_ij . x_ij
+  Vec<D> gradW = Vec<D>::Zero();  // grad_i W(x_ij, h_ij)
+};
+
+/// The running sums of particle i over its neighbours.
+template <int D>
+struct PairSums {
+  double drho = 0.0;
+  Vec<D> a = Vec<D>::Zero();
+};
+
+/// A list of effects applied in order to every pair; an effect absent from the list costs nothing.
+template <class... Effects>
+struct EffectPack {
+  static constexpr bool empty = sizeof...(Effects) == 0;
+  static constexpr bool needs_gradient = (Effects::needs_gradient || ... || false);
+};
+
+}  // namespace sph

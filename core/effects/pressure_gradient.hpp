@@ -1,0 +1,17 @@
+#pragma once
+// Pressure term of the momentum equation, eq. (6): dv_i/dt -= m_j (p_i/rho_i^2 + p_j/rho_j^2) grad_i W.
+#include "core/effects/pair.hpp"
+
+namespace sph {
+
+struct PressureGradient {
+  static constexpr bool needs_gradient = true;
+  template <int D>
+  void operator()(const ParticleView<D>& s, const Pair<D>& pr, PairSums<D>& acc) const {
+    const double ri = s.rho[pr.i], rj = s.rho[pr.j];
+    const double coef = s.p[pr.i] / (ri * ri) + s.p[pr.j] / (rj * rj);
+    acc.a -= (s.m[pr.j] * coef) * pr.gradW;
+  }
+};
+
+}  // namespace sph

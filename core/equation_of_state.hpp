@@ -1,0 +1,33 @@
+#pragma once
+// Tait equation of state, eqs. (7)-(8): p = B ((rho/rho0)^gamma - 1), B = c0^2 rho0 / gamma.
+#include <cmath>
+
+namespace sph {
+
+struct TaitEquationOfState {
+  double rho0 = 1000.0;
+  double c0 = 10.0;
+  double gamma = 7.0;
+
+  double B() const { return c0 * c0 * rho0 / gamma; }
+
+  double pressure(double rho) const {
+    const double r = rho / rho0;
+    if (gamma == 7.0) {
+      const double r2 = r * r, r4 = r2 * r2;
+      return B() * (r4 * r2 * r - 1.0);
+    }
+    return B() * (std::pow(r, gamma) - 1.0);
+  }
+
+  /// Inverse: the density at pressure p (hydrostatic initial state).
+  double density(double p) const { return rho0 * std::pow(1.0 + p / B(), 1.0 / gamma); }
+
+  /// Specific elastic energy e(rho) = int_{rho0}^{rho} p / rho'^2 drho' (zero at rho0, never negative).
+  double specific_energy(double rho) const {
+    const double g1 = gamma - 1.0;
+    return B() * ((std::pow(rho, g1) - std::pow(rho0, g1)) / (g1 * std::pow(rho0, gamma)) + 1.0 / rho - 1.0 / rho0);
+  }
+};
+
+}  // namespace sph

@@ -1,0 +1,60 @@
+#pragma once
+// One per-particle array of the store, with a name and a scratch buffer reused by gathers so that
+// reordering allocates nothing once the store has reached its size.
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "parallel/compaction.hpp"
+
+namespace sph {
+
+/// The value new entries start with: zero for numbers and for Eigen vectors (whose T{} is uninitialised).
+template <class T>
+T zero_value() {
+  if constexpr (requires { T::Zero(); }) {
+    return T::Zero();
+  } else {
+    return T{};
+  }
+}
+
+template <class T>
+class Field {
+ public:
+  using value_type = T;
+  explicit Field(std::string_view name) : name_(name) {}
+
+  std::string_view name() const { return name_; }
+  std::size_t size() const { return data_.size(); }
+  T* data() { return data_.data(); }
+  const T* data() const { return data_.data(); }
+  T& operator[](std::size_t i) { return data_[i]; }
+  const T& operator[](std::size_t i) const { return data_[i]; }
+  std::vector<T>& values() { return data_; }
+  const std::vector<T>& values() const { return data_; }
+
+  void resize(std::size_t n) { data_.resize(n, zero_value<T>()); }
+  void reserve(std::size_t n) { data_.reserve(n); }
+
+  /// data := old data gathered through src (new[k] = old[src[k]]); src.size() is the new size.
+  void gather(const std::vector<std::uint32_t>& src) {
+    scratch_.resize(src.size());
+    par::gather(data_.data(), src.data(), src.size(), scratch_.data());
+    std::swap(data_, scratch_);
+  }
+
+  /// Frees the scratch buffer (after a one-off gather, to give memory back).
+  void release_scratch() { std::vector<T>().swap(scratch_); }
+
+  std::size_t bytes() const { return (data_.capacity() + scratch_.capacity()) * sizeof(T); }
+
+ private:
+  std::string_view name_;
+  std::vector<T> data_;
+  std::vector<T> scratch_;
+};
+
+}  // namespace sph

@@ -1,0 +1,131 @@
+#pragma once
+// The particle store: structure of arrays, the one owner of every per-particle array.
+// `for_each_field` is the field registry: resize, gather (permutation, compaction, expansion), append,
+// output and checkpoints all go through it, so no field can be forgotten when particles move in memory.
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "core/field.hpp"
+#include "core/types.hpp"
+#include "parallel/compaction.hpp"
+
+namespace sph {
+
+/// Raw pointers into the store for hot loops. Valid until the store is resized or gathered.
+template <int D>
+struct ParticleView {
+  std::size_t n = 0;
+  Vec<D>* x = nullptr;
+  Vec<D>* v = nullptr;
+  double* rho = nullptr;
+  double* p = nullptr;
+  double* m = nullptr;
+  double* h = nullptr;
+  double* d = nullptr;
+  std::int32_t* level = nullptr;
+  Kind* kind = nullptr;
+  ParticleId* id = nullptr;
+  double* drho = nullptr;
+  Vec<D>* a = nullptr;
+  Vec<D>* vh = nullptr;
+  double* rhoh = nullptr;
+};
+
+template <int D>
+class ParticleStore {
+ public:
+  static constexpr int dim = D;
+  using VecD = Vec<D>;
+
+  // The fields. Adding one here (and to for_each_field) is all it takes for every operation to carry it.
+  Field<VecD> x{"position"};
+  Field<VecD> v{"velocity"};
+  Field<double> rho{"density"};
+  Field<double> p{"pressure"};
+  Field<double> m{"mass"};
+  Field<double> h{"smoothing_length"};
+  Field<double> d{"spacing"};
+  Field<std::int32_t> level{"level"};
+  Field<Kind> kind{"kind"};
+  Field<ParticleId> id{"id"};
+  Field<double> drho{"density_rate"};
+  Field<VecD> a{"acceleration"};
+  // Integrator stage state (kick-drift-kick): velocity and density at the half step.
+  Field<VecD> vh{"velocity_half"};
+  Field<double> rhoh{"density_half"};
+
+  /// Visits every field (the registry). f is called with each Field<T>&.
+  template <class F>
+  void for_each_field(F&& f) {
+    f(x); f(v); f(rho); f(p); f(m); f(h); f(d); f(level); f(kind); f(id); f(drho); f(a); f(vh); f(rhoh);
+  }
+  template <class F>
+  void for_each_field(F&& f) const {
+    const_cast<ParticleStore*>(this)->for_each_field([&](const auto& field) { f(field); });
+  }
+
+  std::size_t size() const { return x.size(); }
+  bool empty() const { return size() == 0; }
+
+  /// The next id that append() hands out; part of the state (checkpoints keep it).
+  ParticleId next_id() const { return next_id_; }
+  void set_next_id(ParticleId next) { next_id_ = next; }
+  /// Hands out `count` consecutive fresh ids and returns the first.
+  ParticleId take_ids(std::size_t count) {
+    const ParticleId first = next_id_;
+    next_id_ += count;
+    return first;
+  }
+
+  void resize(std::size_t n) {
+    for_each_field([n](auto& f) { f.resize(n); });
+  }
+  void reserve(std::size_t n) {
+    for_each_field([n](auto& f) { f.reserve(n); });
+  }
+  void clear() { resize(0); }
+
+  /// Appends `count` particles with zeroed fields and fresh ids; returns the index of the first.
+  std::size_t append(std::size_t count) {
+    const std::size_t first = size();
+    resize(first + count);
+    const ParticleId id0 = take_ids(count);
+    for (std::size_t k = 0; k < count; ++k) id[first + k] = id0 + k;
+    return first;
+  }
+
+  /// Every field := old field gathered through src (new[k] = old[src[k]]). The one primitive behind
+  /// permutation (src a permutation), compaction (src increasing) and expansion (src repeats indices).
+  void gather(const std::vector<std::uint32_t>& src) {
+    for_each_field([&](auto& f) { f.gather(src); });
+  }
+
+  /// Keeps the particles with keep(i), in order.
+  template <class Keep>
+  void compact(Keep&& keep) {
+    gather(par::compaction_map(size(), std::forward<Keep>(keep)));
+  }
+
+  ParticleView<D> view() {
+    return {size(), x.data(), v.data(), rho.data(), p.data(), m.data(), h.data(), d.data(),
+            level.data(), kind.data(), id.data(), drho.data(), a.data(), vh.data(), rhoh.data()};
+  }
+
+  /// Bytes held by every field (data and scratch), for memory reports.
+  std::size_t bytes() const {
+    std::size_t b = 0;
+    for_each_field([&](const auto& f) { b += f.bytes(); });
+    return b;
+  }
+
+  /// Bytes one particle occupies across all fields.
+  static constexpr std::size_t bytes_per_particle() {
+    return 4 * sizeof(VecD) + 7 * sizeof(double) + sizeof(std::int32_t) + sizeof(Kind) + sizeof(ParticleId);
+  }
+
+ private:
+  ParticleId next_id_ = 0;
+};
+
+}  // namespace sph

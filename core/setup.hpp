@@ -1,0 +1,77 @@
+#pragma once
+// Set-up helpers: square lattices of spacing d filling a rectangle or a circle (particles at the centres
+// of the lattice cells, so a region starts d/2 from its edges and refining every particle with AAP gives
+// the lattice of spacing d/2), and the hydrostatic initial density.
+#include <cmath>
+#include <vector>
+
+#include "core/equation_of_state.hpp"
+#include "core/particle_store.hpp"
+
+namespace sph {
+
+struct FluidBlockSpec {
+  double spacing = 1.0;   // d^0
+  double h_factor = 1.2;  // h = h_factor * d
+  int level = 0;
+  Vec<2> velocity = Vec<2>::Zero();
+};
+
+/// Lattice points (cell centres) of spacing d in [lo, hi].
+inline std::vector<Vec<2>> lattice_rectangle(const Vec<2>& lo, const Vec<2>& hi, double d) {
+  std::vector<Vec<2>> pts;
+  const auto nx = static_cast<long>(std::floor((hi[0] - lo[0]) / d + 1e-9));
+  const auto ny = static_cast<long>(std::floor((hi[1] - lo[1]) / d + 1e-9));
+  pts.reserve(static_cast<std::size_t>(std::max(0L, nx * ny)));
+  for (long iy = 0; iy < ny; ++iy)
+    for (long ix = 0; ix < nx; ++ix)
+      pts.emplace_back(lo[0] + (static_cast<double>(ix) + 0.5) * d, lo[1] + (static_cast<double>(iy) + 0.5) * d);
+  return pts;
+}
+
+/// Lattice points of spacing d through the centre, inside the circle (the paper's drop: radius 2 m at
+/// d = 25/30 m gives its 21 particles).
+inline std::vector<Vec<2>> lattice_circle(const Vec<2>& centre, double radius, double d) {
+  std::vector<Vec<2>> pts;
+  const auto n = static_cast<long>(std::ceil(radius / d)) + 1;
+  for (long iy = -n; iy <= n; ++iy)
+    for (long ix = -n; ix <= n; ++ix) {
+      const Vec<2> p = centre + d * Vec<2>(static_cast<double>(ix), static_cast<double>(iy));
+      if ((p - centre).norm() <= radius) pts.push_back(p);
+    }
+  return pts;
+}
+
+/// Appends fluid particles at the given points, at rest density rho0, mass rho0 d^2.
+inline std::size_t add_fluid(ParticleStore<2>& store, const std::vector<Vec<2>>& points, const FluidBlockSpec& spec,
+                             double rho0) {
+  const std::size_t first = store.append(points.size());
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const std::size_t i = first + k;
+    store.x[i] = points[k];
+    store.v[i] = spec.velocity;
+    store.a[i].setZero();
+    store.rho[i] = rho0;
+    store.p[i] = 0.0;
+    store.m[i] = rho0 * spec.spacing * spec.spacing;
+    store.h[i] = spec.h_factor * spec.spacing;
+    store.d[i] = spec.spacing;
+    store.level[i] = spec.level;
+    store.kind[i] = Kind::fluid;
+    store.drho[i] = 0.0;
+  }
+  return first;
+}
+
+/// Hydrostatic initial density for fluid particles in [first, end): p = rho0 g (surface - y), rho from the
+/// inverse equation of state, so that still water starts near equilibrium.
+inline void set_hydrostatic(ParticleStore<2>& store, std::size_t first, std::size_t end, double surface_y, double g,
+                            const TaitEquationOfState& eos) {
+  for (std::size_t i = first; i < end; ++i) {
+    const double depth = std::max(0.0, surface_y - store.x[i][1]);
+    store.p[i] = eos.rho0 * g * depth;
+    store.rho[i] = eos.density(store.p[i]);
+  }
+}
+
+}  // namespace sph

@@ -1,0 +1,96 @@
+#include "core/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "parallel/parallel_for.hpp"
+
+namespace sph {
+
+Simulation::Simulation(SolverSettings settings) : settings_(std::move(settings)) {
+  if (settings_.ghosts) ghosts_.emplace(settings_.geometry.walls(), *settings_.ghosts);
+  sweep_ = make_sweep(settings_);
+}
+
+void Simulation::prepare_neighbours() {
+  if (ghosts_) {
+    ghosts_->rebuild(store_);
+  }
+  const auto h = store_.h.data();
+  const double hmax = par::reduce(
+      store_.size(), 0.0, [&](std::size_t i) { return h[i]; }, [](double a, double b) { return std::max(a, b); });
+  grid_.build(store_.x.data(), store_.size(), std::max(2.0 * hmax, 1e-12));
+  store_.gather(grid_.order());
+}
+
+void Simulation::refresh() {
+  auto s = store_.view();
+  const TaitEquationOfState eos = settings_.eos;
+  par::parallel_for(s.n, [&](std::size_t i) {
+    if (s.kind[i] == Kind::fluid) s.p[i] = eos.pressure(s.rho[i]);
+  });
+  prepare_neighbours();
+  limits_ = sweep_->run(store_.view(), grid_);
+  dt_ = next_dt();
+}
+
+double Simulation::next_dt() const {
+  const double dt = settings_.cfl * std::min(limits_.dt_force, limits_.dt_cfl);
+  return std::min(dt, settings_.dt_max);
+}
+
+StepInfo Simulation::step(double dt_cap) {
+  const double dt = std::min(dt_, dt_cap);
+  const double half = 0.5 * dt;
+  const TaitEquationOfState eos = settings_.eos;
+  {
+    auto s = store_.view();
+    par::parallel_for(s.n, [&](std::size_t i) {
+      if (s.kind[i] != Kind::fluid) return;
+      s.vh[i] = s.v[i] + half * s.a[i];
+      s.rhoh[i] = s.rho[i] + half * s.drho[i];
+      s.x[i] += dt * s.vh[i];
+      s.v[i] = s.vh[i] + half * s.a[i];
+      s.rho[i] = s.rhoh[i] + half * s.drho[i];
+      s.p[i] = eos.pressure(s.rho[i]);
+    });
+  }
+  prepare_neighbours();
+  limits_ = sweep_->run(store_.view(), grid_);
+  {
+    auto s = store_.view();
+    par::parallel_for(s.n, [&](std::size_t i) {
+      if (s.kind[i] != Kind::fluid) return;
+      s.v[i] = s.vh[i] + half * s.a[i];
+      s.rho[i] = s.rhoh[i] + half * s.drho[i];
+      s.p[i] = eos.pressure(s.rho[i]);
+    });
+  }
+  time_ += dt;
+  ++step_;
+  dt_ = next_dt();
+  return {dt, limits_};
+}
+
+void Simulation::run_stages() {
+  bool changed = false;
+  for (auto& stage : stages_) changed = stage->after_step(*this) || changed;
+  if (changed) refresh();
+}
+
+void Simulation::run_until(double t_end) {
+  while (time_ < t_end * (1.0 - 1e-14)) {
+    step(t_end - time_);
+    run_stages();
+  }
+}
+
+Diagnostics Simulation::diagnostics() const {
+  Diagnostics d = compute_diagnostics(store_, settings_.eos, settings_.gravity.value_or(Vec<2>::Zero()));
+  d.time = time_;
+  d.step = step_;
+  d.dt = dt_;
+  return d;
+}
+
+}  // namespace sph

@@ -1,0 +1,99 @@
+#pragma once
+// The simulation driver: owns the particle store and runs the step pipeline of ARCHITECTURE.md:
+//   kick + drift -> ghosts -> cell grid (reorders the store) -> pair sweep -> kick, variable dt;
+//   between steps, the run-time stages (refinement, probes, output) get one call each.
+//
+// Time integration (PHYSICS.md decision): kick-drift-kick with one force evaluation per step.
+//   v_h = v_n + dt/2 a_n,  rho_h = rho_n + dt/2 drho_n,  x_{n+1} = x_n + dt v_h,
+//   forces at x_{n+1} with the predicted v = v_h + dt/2 a_n and rho = rho_h + dt/2 drho_n,
+//   v_{n+1} = v_h + dt/2 a_{n+1},  rho_{n+1} = rho_h + dt/2 drho_{n+1}.
+// With central pair forces this conserves linear and angular momentum to rounding.
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "core/boundary/ghosts.hpp"
+#include "core/cell_grid.hpp"
+#include "core/diagnostics.hpp"
+#include "core/particle_store.hpp"
+#include "core/solver_settings.hpp"
+#include "core/sweep_factory.hpp"
+
+namespace sph {
+
+class Simulation;
+
+/// A per-stage effect (refinement, probes, output): one call between steps, never one per particle.
+class Stage {
+ public:
+  virtual ~Stage() = default;
+  virtual const char* name() const = 0;
+  /// Called after every step. Returns true when it changed the particle set (the solver then rebuilds
+  /// ghosts and grid and re-evaluates the rates before the next step).
+  virtual bool after_step(Simulation& sim) = 0;
+};
+
+struct StepInfo {
+  double dt = 0.0;
+  SweepLimits limits;
+};
+
+class Simulation {
+ public:
+  explicit Simulation(SolverSettings settings);
+
+  const SolverSettings& settings() const { return settings_; }
+  ParticleStore<2>& store() { return store_; }
+  const ParticleStore<2>& store() const { return store_; }
+  const CellGrid<2>& grid() const { return grid_; }
+  const GhostBuilder* ghosts() const { return ghosts_ ? &*ghosts_ : nullptr; }
+
+  double time() const { return time_; }
+  std::uint64_t step_count() const { return step_; }
+  double dt() const { return dt_; }
+  void set_clock(double time, std::uint64_t step, double dt) {
+    time_ = time;
+    step_ = step;
+    dt_ = dt;
+  }
+
+  /// Evaluates pressures, ghosts, grid and rates for the current state, and the next dt. Call once after
+  /// set-up and after anything changes the particle set.
+  void refresh();
+
+  /// One time step (no stages). dt is min(next dt, dt_cap).
+  StepInfo step(double dt_cap = std::numeric_limits<double>::infinity());
+
+  /// Steps (running the stages after each) until time() reaches t_end.
+  void run_until(double t_end);
+
+  void add_stage(std::unique_ptr<Stage> stage) { stages_.push_back(std::move(stage)); }
+  /// Runs every stage once; refreshes if one changed the particles.
+  void run_stages();
+
+  Diagnostics diagnostics() const;
+  const SweepLimits& last_limits() const { return limits_; }
+  const char* sweep_name() const { return sweep_->name(); }
+
+  /// Drops ghost particles from the store (for output and checkpoints); refresh() brings them back.
+  void remove_ghosts() { GhostBuilder::remove(store_); }
+
+  /// Rebuilds the ghosts and the cell grid and reorders the store into cell order.
+  void prepare_neighbours();
+
+ private:
+  double next_dt() const;
+
+  SolverSettings settings_;
+  ParticleStore<2> store_;
+  CellGrid<2> grid_;
+  std::optional<GhostBuilder> ghosts_;
+  std::unique_ptr<SweepBase> sweep_;
+  std::vector<std::unique_ptr<Stage>> stages_;
+  SweepLimits limits_;
+  double time_ = 0.0;
+  std::uint64_t step_ = 0;
+  double dt_ = 0.0;
+};
+
+}  // namespace sph

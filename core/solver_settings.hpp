@@ -1,0 +1,35 @@
+#pragma once
+// Plain settings of the solver: which effects a scene enables and their constants.
+// An effect that is off is absent from the pair sweep's pack and allocates nothing.
+#include <optional>
+
+#include "core/boundary/ghosts.hpp"
+#include "core/boundary/wall.hpp"
+#include "core/equation_of_state.hpp"
+#include "core/types.hpp"
+
+namespace sph {
+
+struct ViscositySettings {
+  double alpha = 0.02;
+  double beta = 0.0;
+};
+
+struct LennardJonesSettings {
+  double strength = 1.0;   // D (PHYSICS.md default 5 g H_ref, set by the case)
+  double r0_factor = 0.5;  // r0 = r0_factor d^{l_i}; 0.5 keeps it zero at rest with lattices d/2 off the wall
+  double spacing = 0.0;    // wall particle spacing (0: half the finest fluid spacing the scene can reach)
+};
+
+struct SolverSettings {
+  TaitEquationOfState eos;
+  std::optional<Vec<2>> gravity = Vec<2>(0.0, -9.81);
+  std::optional<ViscositySettings> viscosity = ViscositySettings{};
+  std::optional<LennardJonesSettings> lennard_jones;
+  std::optional<GhostSlip> ghosts = GhostSlip::free_slip;
+  Geometry2 geometry;
+  double cfl = 0.2;
+  double dt_max = 1.0;  // upper bound on the step (s)
+};
+
+}  // namespace sph

@@ -1,0 +1,43 @@
+#pragma once
+// Blocked exclusive prefix sum: per-chunk totals in parallel, a serial scan of the chunk totals, then each
+// chunk writes its own offsets. Chunk boundaries are fixed, so the result is the same at any thread count.
+#include <cstddef>
+#include <vector>
+
+#include "parallel/parallel_for.hpp"
+
+namespace sph::par {
+
+/// out[i] = sum_{k<i} in[k]; returns the grand total. `out` may alias `in`. Works for n = 0.
+template <class T>
+T exclusive_scan(const T* in, T* out, std::size_t n) {
+  const std::size_t chunks = chunk_count(n);
+  std::vector<T> total(chunks + 1, T{});
+  parallel_for_dynamic(chunks, 1, [&](std::size_t c) {
+    T acc{};
+    const std::size_t end = std::min(n, (c + 1) * kChunk);
+    for (std::size_t i = c * kChunk; i < end; ++i) acc += in[i];
+    total[c + 1] = acc;
+  });
+  for (std::size_t c = 0; c < chunks; ++c) total[c + 1] += total[c];
+  parallel_for_dynamic(chunks, 1, [&](std::size_t c) {
+    T acc = total[c];
+    const std::size_t end = std::min(n, (c + 1) * kChunk);
+    for (std::size_t i = c * kChunk; i < end; ++i) {
+      const T v = in[i];
+      out[i] = acc;
+      acc += v;
+    }
+  });
+  return total[chunks];
+}
+
+/// Vector form: returns offsets of size n + 1 (the last entry is the total).
+template <class T>
+std::vector<T> exclusive_scan(const std::vector<T>& in) {
+  std::vector<T> out(in.size() + 1);
+  out[in.size()] = exclusive_scan(in.data(), out.data(), in.size());
+  return out;
+}
+
+}  // namespace sph::par
