@@ -23,6 +23,19 @@ void add_lattice(Simulation& sim, const std::vector<Vec<2>>& pts, double spacing
 
 double level_spacing(double d0, int level) { return d0 / std::pow(2.0, level); }
 
+/// The finest level a run can reach (wall particles are spaced at half its spacing).
+int finest_level(int initial, bool fully_refined, const std::optional<refine::RefinementSettings>& r) {
+  int finest = initial + (fully_refined ? 1 : 0);
+  if (r) finest = std::max(finest, r->max_level);
+  return finest;
+}
+
+/// Static refinement and the dynamic stage, as the spec asks.
+void apply_refinement(Simulation& sim, bool fully_refined, const std::optional<refine::RefinementSettings>& r) {
+  if (fully_refined) refine::refine_all(sim, refine::Pattern::aap, 1.0);
+  if (r) refine::add_refinement_stage(sim, *r);
+}
+
 }  // namespace
 
 Simulation make_still_tank(const TankSpec& spec) {
@@ -48,13 +61,16 @@ Simulation make_dam_break(const DamBreakSpec& spec) {
   if (!spec.viscosity) s.viscosity.reset();
   if (!spec.ghosts) s.ghosts.reset();
   const double d = level_spacing(spec.spacing, spec.initial_level);
-  if (spec.lennard_jones) s.lennard_jones = LennardJonesSettings{5.0 * kG * spec.column_height, 0.5, d / 2};
+  const double wall_spacing =
+      0.5 * level_spacing(spec.spacing, finest_level(spec.initial_level, spec.fully_refined, spec.refinement));
+  if (spec.lennard_jones) s.lennard_jones = LennardJonesSettings{5.0 * kG * spec.column_height, 0.5, wall_spacing};
   Simulation sim(s);
   add_lattice(sim, lattice_rectangle(Vec<2>(0, 0), Vec<2>(spec.column_width, spec.column_height), d),
               d, spec.h_factor, spec.initial_level, Vec<2>::Zero());
   set_hydrostatic(sim.store(), 0, sim.store().size(), spec.column_height, kG, s.eos);
-  if (spec.lennard_jones) add_wall_particles(sim.store(), s.geometry.walls(), d / 2, s.eos.rho0);
+  if (spec.lennard_jones) add_wall_particles(sim.store(), s.geometry.walls(), wall_spacing, s.eos.rho0);
   sim.refresh();
+  apply_refinement(sim, spec.fully_refined, spec.refinement);
   return sim;
 }
 
@@ -65,7 +81,9 @@ Simulation make_drop(const DropSpec& spec) {
   const double half = 0.5 * spec.width;
   s.geometry.container = {Vec<2>(-half, 0), Vec<2>(half, 2.0 * spec.depth)};
   const double d = level_spacing(spec.spacing, spec.initial_level);
-  if (spec.lennard_jones) s.lennard_jones = LennardJonesSettings{5.0 * kG * spec.depth, 0.5, d / 2};
+  const double wall_spacing =
+      0.5 * level_spacing(spec.spacing, finest_level(spec.initial_level, spec.fully_refined, spec.refinement));
+  if (spec.lennard_jones) s.lennard_jones = LennardJonesSettings{5.0 * kG * spec.depth, 0.5, wall_spacing};
   Simulation sim(s);
   add_lattice(sim, lattice_rectangle(Vec<2>(-half, 0), Vec<2>(half, spec.depth), d), d, spec.h_factor,
               spec.initial_level, Vec<2>::Zero());
@@ -73,8 +91,9 @@ Simulation make_drop(const DropSpec& spec) {
   set_hydrostatic(sim.store(), 0, pool, spec.depth, kG, s.eos);
   add_lattice(sim, lattice_circle(spec.centre, spec.radius, d), d, spec.h_factor, spec.initial_level,
               Vec<2>(0.0, -spec.drop_speed));
-  if (spec.lennard_jones) add_wall_particles(sim.store(), s.geometry.walls(), d / 2, s.eos.rho0);
+  if (spec.lennard_jones) add_wall_particles(sim.store(), s.geometry.walls(), wall_spacing, s.eos.rho0);
   sim.refresh();
+  apply_refinement(sim, spec.fully_refined, spec.refinement);
   return sim;
 }
 

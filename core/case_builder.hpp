@@ -2,7 +2,9 @@
 // Programmatic set-up of the paper's cases and of simple test scenes (PHYSICS.md, "The paper's cases").
 // Each builder returns a ready Simulation (rates evaluated, dt set).
 #include <memory>
+#include <optional>
 
+#include "core/refinement/refinement_stage.hpp"
 #include "core/simulation.hpp"
 
 namespace sph {
@@ -24,7 +26,9 @@ struct DamBreakSpec {
   double spacing = 25.0 / 30.0;
   double h_factor = 1.2;
   double mach_factor = 10.0;  // c0 = mach_factor * sqrt(2 g H0)
-  int initial_level = 0;      // 1: the fully refined lattice (spacing/2)
+  int initial_level = 0;      // lattice built directly at spacing / 2^initial_level
+  bool fully_refined = false; // static AAP refinement of every particle at set-up (the paper's 3600)
+  std::optional<refine::RefinementSettings> refinement;  // dynamic refinement
   bool lennard_jones = true;
   bool ghosts = true;
   bool viscosity = true;
@@ -40,6 +44,8 @@ struct DropSpec {
   double h_factor = 1.2;
   double mach_factor = 10.0;  // c0 = mach_factor * sqrt(g depth) (a few times the impact speed)
   int initial_level = 0;
+  bool fully_refined = false;
+  std::optional<refine::RefinementSettings> refinement;
   bool lennard_jones = true;
 };
 

@@ -30,10 +30,28 @@ struct Diagnostics {
   double total_energy() const { return kinetic + potential + elastic; }
 };
 
+/// Neumaier-compensated sum: its result is the exact sum correctly rounded in all but pathological cases,
+/// so it does not change when the particles are reordered or split (mass is compared with ==).
+struct CompensatedSum {
+  double sum = 0.0, c = 0.0;
+  void add(double x) {
+    const double t = sum + x;
+    c += std::abs(sum) >= std::abs(x) ? (sum - t) + x : (x - t) + sum;
+    sum = t;
+  }
+  CompensatedSum& merge(const CompensatedSum& o) {
+    add(o.sum);
+    add(o.c);
+    return *this;
+  }
+  double value() const { return sum + c; }
+};
+
 inline Diagnostics compute_diagnostics(const ParticleStore<2>& store, const TaitEquationOfState& eos,
                                        const Vec<2>& gravity) {
   struct Acc {
-    double mass = 0, ke = 0, pe = 0, el = 0, L = 0, vmax = 0, derr = 0;
+    CompensatedSum mass;
+    double ke = 0, pe = 0, el = 0, L = 0, vmax = 0, derr = 0;
     Vec<2> P = Vec<2>::Zero();
     std::size_t fluid = 0, ghosts = 0, walls = 0;
   };
@@ -55,7 +73,7 @@ inline Diagnostics compute_diagnostics(const ParticleStore<2>& store, const Tait
           return a;
         }
         a.fluid = 1;
-        a.mass = m[i];
+        a.mass.add(m[i]);
         a.ke = 0.5 * m[i] * v[i].squaredNorm();
         a.pe = -m[i] * gravity.dot(x[i]);
         a.el = m[i] * eos.specific_energy(rho[i]);
@@ -67,7 +85,8 @@ inline Diagnostics compute_diagnostics(const ParticleStore<2>& store, const Tait
       },
       [](const Acc& a, const Acc& b) {
         Acc c;
-        c.mass = a.mass + b.mass;
+        c.mass = a.mass;
+        c.mass.merge(b.mass);
         c.ke = a.ke + b.ke;
         c.pe = a.pe + b.pe;
         c.el = a.el + b.el;
@@ -81,7 +100,7 @@ inline Diagnostics compute_diagnostics(const ParticleStore<2>& store, const Tait
         return c;
       });
   Diagnostics d;
-  d.mass = acc.mass;
+  d.mass = acc.mass.value();
   d.kinetic = acc.ke;
   d.potential = acc.pe;
   d.elastic = acc.el;

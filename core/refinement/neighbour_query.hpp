@@ -1,0 +1,41 @@
+#pragma once
+// Neighbour queries on the store as it stands between steps (positions have moved since the step's grid
+// was built): a cell grid built over the current positions without reordering the store.
+#include <cstdint>
+
+#include "core/cell_grid.hpp"
+#include "core/particle_store.hpp"
+
+namespace sph::refine {
+
+class NeighbourQuery {
+ public:
+  explicit NeighbourQuery(const ParticleStore<2>& store) : store_(store) {
+    double hmax = 0.0;
+    for (std::size_t i = 0; i < store.size(); ++i) hmax = std::max(hmax, store.h[i]);
+    grid_.build(store.x.data(), store.size(), std::max(2.0 * hmax, 1e-12));
+  }
+
+  /// Calls f(j, r) for every fluid particle j != i with r_ij < 2 h_ij, in a fixed order.
+  template <class F>
+  void for_each_fluid_neighbour(std::size_t i, F&& f) const {
+    const auto& order = grid_.order();
+    const Vec<2> xi = store_.x[i];
+    const double hi = store_.h[i];
+    grid_.for_each_candidate_run(xi, [&](std::uint32_t b, std::uint32_t e) {
+      for (std::uint32_t k = b; k < e; ++k) {
+        const std::uint32_t j = order[k];
+        if (j == i || store_.kind[j] != Kind::fluid) continue;
+        const double r2 = (xi - store_.x[j]).squaredNorm();
+        const double support = hi + store_.h[j];
+        if (r2 < support * support) f(static_cast<std::size_t>(j), std::sqrt(r2));
+      }
+    });
+  }
+
+ private:
+  const ParticleStore<2>& store_;
+  CellGrid<2> grid_;
+};
+
+}  // namespace sph::refine

@@ -1,0 +1,31 @@
+#pragma once
+// Settings of dynamic refinement (section 3; PHYSICS.md "Refinement").
+#include <optional>
+
+#include "core/boundary/wall.hpp"
+
+namespace sph::refine {
+
+/// Where daughters go: the axis-aligned square (AAP) or the square rotated towards and scaled by the
+/// neighbour of largest F_ij = d_ij / r_ij (RSP), side s = k d^{l_i} / F_ij.
+enum class Pattern { aap, rsp };
+
+/// Which particles get marked. The split pass never knows which criterion marked a particle.
+enum class CriterionKind {
+  velocity,       // |v_i| > v_threshold (the paper's)
+  zone,           // x_i inside a fixed box
+  few_neighbours  // fewer than min_neighbours fluid neighbours within 2 h_ij
+};
+
+struct RefinementSettings {
+  CriterionKind criterion = CriterionKind::velocity;
+  double v_threshold = 10.0;  // m/s
+  Box2 zone{Vec<2>(0, 0), Vec<2>(0, 0)};
+  int min_neighbours = 8;
+  Pattern pattern = Pattern::aap;
+  double rsp_k = 1.0;       // 1/2 as printed in the paper, 1 the consistent reading
+  int check_interval = 100; // steps between checks
+  int max_level = 1;        // daughters of level max_level are never refined
+};
+
+}  // namespace sph::refine

@@ -1,0 +1,50 @@
+#pragma once
+// Dynamic refinement as a run-time stage: every check_interval steps, the criterion marks, the split pass
+// splits, and the solver rebuilds ghosts and grid and re-evaluates the rates (Simulation::run_stages).
+// Static refinement at set-up (the paper's Fig. 1b) uses the same patterns and pass.
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/refinement/criteria.hpp"
+#include "core/refinement/refinement_settings.hpp"
+#include "core/refinement/split_pass.hpp"
+#include "core/simulation.hpp"
+
+namespace sph::refine {
+
+/// One line of the refinement log: what a pass did.
+struct PassRecord {
+  std::uint64_t step = 0;
+  double time = 0.0;
+  std::size_t refined = 0;
+  std::size_t shifted = 0;
+  std::vector<std::size_t> per_level;  // fluid particles per level after the pass
+};
+
+class RefinementStage final : public Stage {
+ public:
+  explicit RefinementStage(const RefinementSettings& settings);
+  const char* name() const override { return "refinement"; }
+  bool after_step(Simulation& sim) override;
+
+  const RefinementSettings& settings() const { return settings_; }
+  const std::vector<PassRecord>& log() const { return log_; }
+  std::size_t total_refined() const { return total_; }
+
+ private:
+  RefinementSettings settings_;
+  std::unique_ptr<Criterion> criterion_;
+  std::vector<PassRecord> log_;
+  std::size_t total_ = 0;
+};
+
+/// Adds dynamic refinement to a simulation; returns the stage (owned by the simulation) for its log.
+RefinementStage& add_refinement_stage(Simulation& sim, const RefinementSettings& settings);
+
+/// Static refinement at set-up: splits every fluid particle (fully refined runs) or those in a box, then
+/// refreshes the simulation. Returns how many were split.
+std::size_t refine_all(Simulation& sim, Pattern pattern, double rsp_k);
+std::size_t refine_region(Simulation& sim, const Box2& box, Pattern pattern, double rsp_k);
+
+}  // namespace sph::refine

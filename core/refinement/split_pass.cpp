@@ -1,0 +1,76 @@
+#include "core/refinement/split_pass.hpp"
+
+#include <optional>
+
+#include "core/refinement/patterns.hpp"
+#include "parallel/compaction.hpp"
+#include "parallel/parallel_for.hpp"
+
+namespace sph::refine {
+
+SplitResult split_marked(ParticleStore<2>& store, const std::vector<std::uint8_t>& marks, Pattern pattern,
+                         double rsp_k, int max_level, const std::vector<Wall2>& walls) {
+  const std::size_t n = store.size();
+  auto splits = [&](std::size_t i) {
+    return marks[i] != 0 && store.kind[i] == Kind::fluid && store.level[i] < max_level;
+  };
+  // Offsets of the daughters, computed on the store as it is (RSP needs the neighbours), indexed by the
+  // rank of the split particle.
+  std::vector<std::uint32_t> rank_offsets;
+  const std::vector<std::uint32_t> split_index =
+      par::expansion_map(n, [&](std::size_t i) { return splits(i) ? 1u : 0u; }, &rank_offsets);
+  const std::size_t count = split_index.size();
+  SplitResult result;
+  result.refined = count;
+  if (count == 0) {
+    // Still drop ghosts so the pass always leaves the same kind of store.
+    store.compact([&](std::size_t i) { return store.kind[i] != Kind::ghost; });
+    return result;
+  }
+  std::vector<Offsets> offsets(count);
+  std::vector<std::uint8_t> shifted(count, 0);
+  {
+    std::optional<NeighbourQuery> query;
+    if (pattern == Pattern::rsp) query.emplace(store);
+    par::parallel_for(count, [&](std::size_t r) {
+      const std::size_t i = split_index[r];
+      Offsets o = pattern == Pattern::aap
+                      ? axis_aligned_pattern(store.d[i])
+                      : rotated_scaled_pattern(store.d[i], find_reference(store, *query, i), rsp_k);
+      shifted[r] = keep_inside_walls(store.x[i], o, walls, 0.25 * (0.5 * store.d[i])) ? 1 : 0;
+      offsets[r] = o;
+    });
+  }
+  for (std::uint8_t s : shifted) result.shifted += s;
+
+  std::vector<std::uint32_t> out_offsets;
+  const std::vector<std::uint32_t> src = par::expansion_map(
+      n,
+      [&](std::size_t i) -> std::uint32_t {
+        if (store.kind[i] == Kind::ghost) return 0;
+        return splits(i) ? 4u : 1u;
+      },
+      &out_offsets);
+  const ParticleId first_id = store.take_ids(4 * count);
+  store.gather(src);
+  auto s = store.view();
+  par::parallel_for(count, [&](std::size_t r) {
+    const std::size_t i = split_index[r];  // index before the gather
+    const std::size_t first = out_offsets[i];
+    const Vec<2> xi = s.x[first];
+    const double m = 0.25 * s.m[first], h = 0.5 * s.h[first], d = 0.5 * s.d[first];
+    const std::int32_t level = s.level[first] + 1;
+    for (std::size_t a = 0; a < 4; ++a) {
+      const std::size_t k = first + a;
+      s.x[k] = xi + offsets[r][a];
+      s.m[k] = m;
+      s.h[k] = h;
+      s.d[k] = d;
+      s.level[k] = level;
+      s.id[k] = first_id + 4 * r + a;
+    }
+  });
+  return result;
+}
+
+}  // namespace sph::refine
