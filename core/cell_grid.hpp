@@ -40,7 +40,9 @@ class CellGrid {
     const double inf = std::numeric_limits<double>::infinity();
     Box init{VecD::Constant(inf), VecD::Constant(-inf)};
     Box box = par::reduce(
-        n, init, [&](std::size_t i) { return Box{x[i], x[i]}; },
+        n, init,
+        // A NaN would vanish in min/max; map any non-finite position to an infinite box so it is caught below.
+        [&](std::size_t i) { return x[i].allFinite() ? Box{x[i], x[i]} : Box{VecD::Constant(-inf), VecD::Constant(inf)}; },
         [](const Box& a, const Box& b) { return Box{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)}; });
     if (n == 0) box = Box{VecD::Zero(), VecD::Zero()};
     for (int k = 0; k < D; ++k) {
@@ -48,7 +50,10 @@ class CellGrid {
         throw std::runtime_error("CellGrid::build: a particle position is not finite");
       }
     }
-    cell_size_ = min_cell_size;
+    // A relative margin over the requested size: coords() rounds, and a pair at distance ~min_cell_size
+    // (up to rounding) could otherwise land two cells apart and be missed. 1e-6 exceeds the rounding error
+    // of (p - origin) * inv_cell for any coordinate below kMaxCells cells.
+    cell_size_ = min_cell_size * (1.0 + 1e-6);
     for (;;) {
       std::size_t total = 1;
       for (int k = 0; k < D; ++k) {

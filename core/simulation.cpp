@@ -41,6 +41,8 @@ double Simulation::next_dt() const {
 
 StepInfo Simulation::step(double dt_cap) {
   const double dt = std::min(dt_, dt_cap);
+  const bool watch = settings_.watchdog.enabled;
+  if (watch) last_good_ = store_;  // reuses capacity: no allocation once the sizes are stable
   const double half = 0.5 * dt;
   const TaitEquationOfState eos = settings_.eos;
   {
@@ -65,6 +67,21 @@ StepInfo Simulation::step(double dt_cap) {
       s.rho[i] = s.rhoh[i] + half * s.drho[i];
       s.p[i] = eos.pressure(s.rho[i]);
     });
+  }
+  if (watch) {
+    FailureReport report;
+    if (find_failure(store_, settings_.geometry, eos.rho0, settings_.watchdog, report) ||
+        !(std::isfinite(dt) && dt > 0.0)) {
+      if (report.quantity.empty()) {
+        report.quantity = "the time step is not a positive finite number";
+        report.cause = "an acceleration or velocity became NaN or Inf";
+      }
+      report.step = step_ + 1;
+      report.time = time_ + dt;
+      std::swap(store_, last_good_);
+      refresh();
+      throw SimulationFailure(report);
+    }
   }
   time_ += dt;
   ++step_;

@@ -61,7 +61,9 @@ class Simulation {
   /// set-up and after anything changes the particle set.
   void refresh();
 
-  /// One time step (no stages). dt is min(next dt, dt_cap).
+  /// One time step (no stages). dt is min(next dt, dt_cap). With the watchdog on, a step that produces a
+  /// NaN/Inf, a density error past the limit or a particle outside the domain is undone (the simulation is
+  /// back at the last good state) and SimulationFailure is thrown.
   StepInfo step(double dt_cap = std::numeric_limits<double>::infinity());
 
   /// Steps (running the stages after each) until time() reaches t_end.
@@ -91,6 +93,7 @@ class Simulation {
   std::unique_ptr<SweepBase> sweep_;
   std::vector<std::unique_ptr<Stage>> stages_;
   SweepLimits limits_;
+  ParticleStore<2> last_good_;  // the state before the current step (watchdog rollback)
   double time_ = 0.0;
   std::uint64_t step_ = 0;
   double dt_ = 0.0;

@@ -7,6 +7,7 @@
 #include "core/boundary/wall.hpp"
 #include "core/equation_of_state.hpp"
 #include "core/types.hpp"
+#include "core/watchdog.hpp"
 
 namespace sph {
 
@@ -30,6 +31,7 @@ struct SolverSettings {
   Geometry2 geometry;
   double cfl = 0.2;
   double dt_max = 1.0;  // upper bound on the step (s)
+  WatchdogSettings watchdog;
 };
 
 }  // namespace sph

@@ -1,0 +1,74 @@
+#include "core/watchdog.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "parallel/parallel_for.hpp"
+
+namespace sph {
+
+std::string FailureReport::message() const {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, "run stopped at step %llu, t = %.6g s: particle %llu at (%.6g, %.6g): %s. Likely cause: %s",
+                static_cast<unsigned long long>(step), time, static_cast<unsigned long long>(id), position[0],
+                position[1], quantity.c_str(), cause.c_str());
+  return buf;
+}
+
+bool find_failure(const ParticleStore<2>& store, const Geometry2& geometry, double rho0,
+                  const WatchdogSettings& settings, FailureReport& out) {
+  constexpr std::size_t none = std::numeric_limits<std::size_t>::max();
+  struct Hit {
+    std::size_t index;
+    int kind;
+  };
+  auto classify = [&](std::size_t i) -> int {
+    if (store.kind[i] != Kind::fluid) return -1;
+    const Vec<2>& x = store.x[i];
+    const Vec<2>& v = store.v[i];
+    if (!std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(v[0]) || !std::isfinite(v[1]) ||
+        !std::isfinite(store.rho[i]) || !std::isfinite(store.p[i]))
+      return 0;
+    if (std::abs(store.rho[i] / rho0 - 1.0) > settings.max_density_error) return 1;
+    if (!geometry.in_fluid_domain(x)) return 2;
+    return -1;
+  };
+  const Hit hit = par::reduce(
+      store.size(), Hit{none, -1},
+      [&](std::size_t i) {
+        const int k = classify(i);
+        return k < 0 ? Hit{none, -1} : Hit{i, k};
+      },
+      [](const Hit& a, const Hit& b) { return a.index <= b.index ? a : b; });
+  if (hit.index == none) return false;
+  const std::size_t i = hit.index;
+  out.id = store.id[i];
+  out.position = store.x[i];
+  char buf[160];
+  switch (hit.kind) {
+    case 0:
+      out.kind = FailureKind::not_finite;
+      out.quantity = "position, velocity, density or pressure is NaN or Inf";
+      out.cause = "a time step too large for the sound speed (lower time.cfl or check material.c0), or two particles "
+                  "at zero distance";
+      break;
+    case 1:
+      out.kind = FailureKind::density;
+      std::snprintf(buf, sizeof buf, "density error |rho/rho0 - 1| = %.3g exceeds the limit %.3g",
+                    std::abs(store.rho[i] / rho0 - 1.0), settings.max_density_error);
+      out.quantity = buf;
+      out.cause = "compression beyond the weakly-compressible range: the sound speed is too low for the flow "
+                  "(raise c0 or the Mach factor) or the time step too large";
+      break;
+    default:
+      out.kind = FailureKind::left_domain;
+      out.quantity = "the particle left the domain (outside the container or inside an obstacle)";
+      out.cause = "wall penetration: walls too weak for the impact speed (enable the Lennard-Jones wall or ghost "
+                  "walls, raise its strength) or a time step too large";
+      break;
+  }
+  return true;
+}
+
+}  // namespace sph

@@ -1,0 +1,45 @@
+#pragma once
+// The watchdog checks the state after every step: a NaN or Inf, a density error past a limit, a particle
+// leaving the domain. On failure the simulation is put back to the last good state (the step before) and a
+// SimulationFailure names the step, time, particle, quantity and the likely cause.
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+#include "core/boundary/wall.hpp"
+#include "core/particle_store.hpp"
+
+namespace sph {
+
+struct WatchdogSettings {
+  bool enabled = true;
+  double max_density_error = 0.5;  // |rho/rho0 - 1| past this stops the run
+};
+
+enum class FailureKind { not_finite, density, left_domain };
+
+struct FailureReport {
+  FailureKind kind = FailureKind::not_finite;
+  std::uint64_t step = 0;
+  double time = 0.0;
+  ParticleId id = 0;
+  Vec<2> position = Vec<2>::Zero();
+  std::string quantity;
+  std::string cause;
+  std::string message() const;
+};
+
+class SimulationFailure : public std::runtime_error {
+ public:
+  explicit SimulationFailure(FailureReport report) : std::runtime_error(report.message()), report_(std::move(report)) {}
+  const FailureReport& report() const { return report_; }
+
+ private:
+  FailureReport report_;
+};
+
+/// Scans the fluid particles; returns the failure of the lowest-index offender (deterministic), if any.
+bool find_failure(const ParticleStore<2>& store, const Geometry2& geometry, double rho0,
+                  const WatchdogSettings& settings, FailureReport& out);
+
+}  // namespace sph
