@@ -38,11 +38,18 @@ struct CubicSpline {
     return 0.0;
   }
 
-  /// (dW/dr) / r, the factor that multiplies x_ij to give grad_i W; finite as r -> 0 (returns the limit
-  /// times 0 contribution: the gradient at r = 0 is zero because x_ij = 0).
+  /// (dW/dr) / r, the factor that multiplies x_ij to give grad_i W. Written in q so that the inner branch
+  /// needs no division by r; at r = 0 it returns 0 (the gradient there is zero).
   static double gradient_factor(double r, double h) {
-    if (r <= 0.0) return 0.0;
-    return derivative(r, h) / r;
+    const double inv_h = 1.0 / h;
+    const double q = r * inv_h;
+    const double c = norm(h) * inv_h * inv_h;  // sigma / h^(D+2)
+    if (q < 1.0) return r > 0.0 ? c * (-3.0 + 2.25 * q) : 0.0;
+    if (q < 2.0) {
+      const double t = 2.0 - q;
+      return c * (-0.75 * t * t / q);
+    }
+    return 0.0;
   }
 };
 

@@ -53,6 +53,17 @@ TEST(Kernel, GradientEqualsFiniteDifference) {
   check_derivative<3>(1.7);
 }
 
+TEST(Kernel, GradientFactorTimesRIsTheDerivative) {
+  // The sweep's fast form (written in q, no division by r inside the core) against dW/dr / r.
+  for (double h : {0.4, 1.0, 3.0})
+    for (double r = 0.013 * h; r < 2.1 * h; r += 0.0517 * h) {
+      const double ref = CubicSpline<2>::derivative(r, h) / r;
+      EXPECT_NEAR(CubicSpline<2>::gradient_factor(r, h), ref, 1e-13 * std::abs(CubicSpline<2>::norm(h)) / (h * h));
+      const double ref3 = CubicSpline<3>::derivative(r, h) / r;
+      EXPECT_NEAR(CubicSpline<3>::gradient_factor(r, h), ref3, 1e-13 * std::abs(CubicSpline<3>::norm(h)) / (h * h));
+    }
+}
+
 TEST(Kernel, CompactSupport) {
   for (double h : {0.3, 1.0, 2.5}) {
     EXPECT_EQ(CubicSpline<2>::value(2.0 * h, h), 0.0);
