@@ -40,10 +40,13 @@ struct CubicSpline {
 
   /// (dW/dr) / r, the factor that multiplies x_ij to give grad_i W. Written in q so that the inner branch
   /// needs no division by r; at r = 0 it returns 0 (the gradient there is zero).
-  static double gradient_factor(double r, double h) {
-    const double inv_h = 1.0 / h;
+  static double gradient_factor(double r, double h) { return gradient_factor_inv(r, 1.0 / h); }
+
+  /// The same with 1/h given (the sweep reuses it across pairs of equal h): no division in the inner core.
+  static double gradient_factor_inv(double r, double inv_h) {
     const double q = r * inv_h;
-    const double c = norm(h) * inv_h * inv_h;  // sigma / h^(D+2)
+    double c = sigma * inv_h * inv_h;  // sigma / h^(D+2)
+    for (int k = 0; k < D; ++k) c *= inv_h;
     if (q < 1.0) return r > 0.0 ? c * (-3.0 + 2.25 * q) : 0.0;
     if (q < 2.0) {
       const double t = 2.0 - q;

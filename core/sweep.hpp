@@ -53,6 +53,8 @@ class PairSweep {
           const Vec<D> xi = s.x[i];
           const Vec<D> vi = s.v[i];
           const double hi = s.h[i];
+          const double inv_hi = 1.0 / hi;
+          pr.p_rho2_i = s.p[i] / (s.rho[i] * s.rho[i]);
           grid.for_each_candidate_run(xi, [&](std::uint32_t b, std::uint32_t e) {
             for (std::uint32_t j = b; j < e; ++j) {
               const Vec<D> xij = xi - s.x[j];
@@ -73,9 +75,11 @@ class PairSweep {
                 }
                 continue;
               }
-              pr.gradW = Kernel::gradient_factor(pr.r, pr.hij) * xij;
+              const double inv_hij = s.h[j] == hi ? inv_hi : 1.0 / pr.hij;
+              pr.gradW = Kernel::gradient_factor_inv(pr.r, inv_hij) * xij;
+              pr.mu = pr.hij * pr.vx / (r2 + 0.01 * pr.hij * pr.hij);
               std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, fluid_);
-              mu_max = std::max(mu_max, std::abs(pr.hij * pr.vx / (r2 + 0.01 * pr.hij * pr.hij)));
+              mu_max = std::max(mu_max, std::abs(pr.mu));
             }
           });
           acc.a += gravity_;

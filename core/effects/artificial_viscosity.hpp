@@ -15,7 +15,7 @@ struct ArtificialViscosity {
   template <int D>
   void operator()(const ParticleView<D>& s, const Pair<D>& pr, PairSums<D>& acc) const {
     if (pr.vx >= 0.0) return;  // receding pairs feel no viscosity
-    const double mu = pr.hij * pr.vx / (pr.r2 + 0.01 * pr.hij * pr.hij);
+    const double mu = pr.mu;
     const double rho_bar = 0.5 * (s.rho[pr.i] + s.rho[pr.j]);
     const double Pi = (-alpha * c0 * mu + beta * mu * mu) / rho_bar;
     acc.a -= (s.m[pr.j] * Pi) * pr.gradW;

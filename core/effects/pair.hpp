@@ -16,6 +16,8 @@ struct Pair {
   double r = 0;    // |x_ij|
   double hij = 0;  // (h_i + h_j) / 2, section 2.3
   double vx = 0;   // v_ij . x_ij
+  double mu = 0;   // h_ij v_ij.x_ij / (r_ij^2 + 0.01 h_ij^2), eq. (9) and the time-step limit
+  double p_rho2_i = 0;  // p_i / rho_i^2, fixed for particle i
   Vec<D> gradW = Vec<D>::Zero();  // grad_i W(x_ij, h_ij)
 };
 

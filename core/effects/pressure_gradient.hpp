@@ -8,8 +8,8 @@ struct PressureGradient {
   static constexpr bool needs_gradient = true;
   template <int D>
   void operator()(const ParticleView<D>& s, const Pair<D>& pr, PairSums<D>& acc) const {
-    const double ri = s.rho[pr.i], rj = s.rho[pr.j];
-    const double coef = s.p[pr.i] / (ri * ri) + s.p[pr.j] / (rj * rj);
+    const double rj = s.rho[pr.j];
+    const double coef = pr.p_rho2_i + s.p[pr.j] / (rj * rj);
     acc.a -= (s.m[pr.j] * coef) * pr.gradW;
   }
 };

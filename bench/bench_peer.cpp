@@ -1,0 +1,73 @@
+// The peer comparison of ../shared/ANCHORS.md: DualSPHysics 5.4's own 2D dam break (a 1 m x 2 m column in a
+// 4 m x 3 m tank) at its three particle counts and simulated windows, timed as a whole solver run with no
+// output. Our settings as close as our physics allows: h/d = sqrt(2) (its neighbour count) or our default
+// 1.2, c0 = 20 sqrt(g H), artificial viscosity alpha = 0.02, CFL 0.2, hydrostatic start; walls are ghost
+// (free-slip) + Lennard-Jones particles instead of its dynamic boundary particles; double precision.
+// Args: {dp index 0..2, threads, h/d x 1000}. Reports fluid particle-steps/s and pair interactions/s.
+#include <benchmark/benchmark.h>
+#include <omp.h>
+
+#include <cmath>
+
+#include "core/case_builder.hpp"
+
+namespace {
+
+using namespace sph;
+
+struct PeerCase {
+  double dp;
+  double window;  // simulated seconds from rest
+};
+constexpr PeerCase kCases[] = {{1.0 / 45, 0.4}, {1.0 / 122, 0.1}, {1.0 / 354, 0.008}};
+
+void BM_Peer_DamBreak(benchmark::State& state) {
+  const PeerCase c = kCases[state.range(0)];
+  omp_set_num_threads(static_cast<int>(state.range(1)));
+  const double h_factor = static_cast<double>(state.range(2)) / 1000.0;
+  std::uint64_t steps = 0;
+  std::size_t fluid = 0;
+  double pairs = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    DamBreakSpec spec;
+    spec.column_width = 1.0;
+    spec.column_height = 2.0;
+    spec.tank_width = 4.0;
+    spec.tank_height = 3.0;
+    spec.spacing = c.dp;
+    spec.h_factor = h_factor;
+    spec.mach_factor = 20.0 / std::sqrt(2.0);  // c0 = mach sqrt(2 g H) = 20 sqrt(g H)
+    Simulation sim = make_dam_break(spec);
+    sim.set_clock(0.0, 0, sim.dt());
+    fluid = sim.diagnostics().fluid;
+    pairs = 0;
+    state.ResumeTiming();
+    while (sim.time() < c.window) {
+      const StepInfo info = sim.step(c.window - sim.time());
+      pairs += static_cast<double>(info.limits.pairs);
+    }
+    steps = sim.step_count();
+  }
+  state.counters["fluid"] = static_cast<double>(fluid);
+  state.counters["steps"] = static_cast<double>(steps);
+  state.counters["particle_steps_per_s"] =
+      benchmark::Counter(static_cast<double>(fluid * steps) * static_cast<double>(state.iterations()),
+                         benchmark::Counter::kIsRate);
+  state.counters["pairs_per_s"] =
+      benchmark::Counter(pairs * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["pairs_per_particle"] = pairs / static_cast<double>(fluid * steps);
+}
+
+void peer_args(benchmark::internal::Benchmark* b) {
+  for (int64_t k : {0, 1, 2})
+    for (int64_t t : {1, 2})
+      for (int64_t hf : {1414, 1200}) b->Args({k, t, hf});
+}
+
+BENCHMARK(BM_Peer_DamBreak)->Apply(peer_args)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true)
+    ->Unit(benchmark::kSecond)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();
