@@ -13,14 +13,55 @@ Simulation::Simulation(SolverSettings settings) : settings_(std::move(settings))
 }
 
 void Simulation::prepare_neighbours() {
+  const auto view = store_.view();
+  const std::size_t n = view.n;
+  // 1. The expansion: each particle's outputs (ghosts 0, walls 1, fluid 1 + its images).
+  expand_offsets_.resize(n + 1);
   if (ghosts_) {
-    ghosts_->rebuild(store_);
+    par::parallel_for(n, [&](std::size_t i) { expand_offsets_[i] = ghosts_->output_count(view, i); });
+  } else {
+    par::parallel_for(n, [&](std::size_t i) { expand_offsets_[i] = 1; });
   }
-  const auto h = store_.h.data();
+  expand_offsets_[n] = par::exclusive_scan(expand_offsets_.data(), expand_offsets_.data(), n);
+  const std::size_t m = expand_offsets_[n];
+  expand_src_.resize(m);
+  expand_image_.resize(m);
+  expand_x_.resize(m);
+  par::parallel_for(n, [&](std::size_t i) {
+    const std::uint32_t first = expand_offsets_[i], count = expand_offsets_[i + 1] - first;
+    if (count == 0) return;
+    expand_src_[first] = static_cast<std::uint32_t>(i);
+    expand_image_[first] = -1;
+    expand_x_[first] = view.x[i];
+    if (count == 1) return;
+    const GhostBuilder::Images im = ghosts_->images(view.x[i], view.v[i], view.h[i]);
+    for (std::uint32_t g = 1; g < count; ++g) {
+      expand_src_[first + g] = static_cast<std::uint32_t>(i);
+      expand_image_[first + g] = static_cast<std::int8_t>(g - 1);
+      expand_x_[first + g] = im.x[g - 1];
+    }
+  });
+  // 2. The cell sort of the expanded set, composed with the expansion into one source map.
+  const auto h = view.h;
   const double hmax = par::reduce(
-      store_.size(), 0.0, [&](std::size_t i) { return h[i]; }, [](double a, double b) { return std::max(a, b); });
-  grid_.build(store_.x.data(), store_.size(), std::max(2.0 * hmax, 1e-12));
-  store_.gather(grid_.order());
+      n, 0.0, [&](std::size_t i) { return view.kind[i] == Kind::ghost ? 0.0 : h[i]; },
+      [](double a, double b) { return std::max(a, b); });
+  grid_.build(expand_x_.data(), m, std::max(2.0 * hmax, 1e-12));
+  const auto& order = grid_.order();
+  gather_src_.resize(m);
+  gather_image_.resize(m);
+  par::parallel_for(m, [&](std::size_t k) {
+    gather_src_[k] = expand_src_[order[k]];
+    gather_image_[k] = expand_image_[order[k]];
+  });
+  // 3. One gather of every field, then the copies that are ghosts become ghosts.
+  store_.gather(gather_src_);
+  if (ghosts_) {
+    auto s = store_.view();
+    par::parallel_for(m, [&](std::size_t k) {
+      if (gather_image_[k] >= 0) ghosts_->make_ghost(s, k, gather_image_[k]);
+    });
+  }
 }
 
 void Simulation::refresh() {

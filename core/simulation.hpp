@@ -80,7 +80,9 @@ class Simulation {
   /// Drops ghost particles from the store (for output and checkpoints); refresh() brings them back.
   void remove_ghosts() { GhostBuilder::remove(store_); }
 
-  /// Rebuilds the ghosts and the cell grid and reorders the store into cell order.
+  /// Rebuilds the ghosts and the cell grid and reorders the store into cell order, with one gather of
+  /// every field: old ghosts dropped and new ones added (a stream expansion) and the cell sort composed
+  /// into a single source map.
   void prepare_neighbours();
 
  private:
@@ -93,7 +95,11 @@ class Simulation {
   std::unique_ptr<SweepBase> sweep_;
   std::vector<std::unique_ptr<Stage>> stages_;
   SweepLimits limits_;
-  ParticleStore<2> last_good_;  // the state before the current step (watchdog rollback)
+  ParticleStore<2> last_good_;
+  // Step workspace of prepare_neighbours (reused, so a step allocates nothing once sizes settle).
+  std::vector<std::uint32_t> expand_src_, expand_offsets_, gather_src_;
+  std::vector<std::int8_t> expand_image_, gather_image_;
+  std::vector<Vec<2>> expand_x_;  // the state before the current step (watchdog rollback)
   double time_ = 0.0;
   std::uint64_t step_ = 0;
   double dt_ = 0.0;

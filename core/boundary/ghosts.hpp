@@ -60,6 +60,23 @@ class GhostBuilder {
     return out;
   }
 
+  /// How many outputs particle i has in a rebuild: old ghosts 0, walls 1, fluid 1 + its images.
+  std::uint32_t output_count(const ParticleView<2>& view, std::size_t i) const {
+    if (view.kind[i] == Kind::ghost) return 0;
+    if (view.kind[i] != Kind::fluid) return 1;
+    return 1u + static_cast<std::uint32_t>(images(view.x[i], view.v[i], view.h[i]).count);
+  }
+
+  /// Turns item k, a copy of its source particle, into that source's ghost number `image` (0-based).
+  void make_ghost(ParticleView<2>& s, std::size_t k, int image) const {
+    const Images im = images(s.x[k], s.v[k], s.h[k]);
+    s.x[k] = im.x[static_cast<std::size_t>(image)];
+    s.v[k] = im.v[static_cast<std::size_t>(image)];
+    s.kind[k] = Kind::ghost;
+    s.a[k].setZero();
+    s.drho[k] = 0.0;
+  }
+
   /// Drops the old ghosts and writes the new ones right after their source particle.
   void rebuild(ParticleStore<2>& store) const {
     std::vector<std::uint32_t> offsets;
