@@ -26,6 +26,11 @@ class CellGrid {
   using VecD = Vec<D>;
   /// Upper bound on the number of cells; past it the cell size grows (sparse, far-flung particles).
   static constexpr std::size_t kMaxCells = std::size_t{1} << 26;
+  /// The cell budget for n particles: 16 cells a particle (at least 2^16), so a few far-flung particles
+  /// cannot make the grid's memory grow beyond a small multiple of the store's.
+  static std::size_t cell_budget(std::size_t n) {
+    return std::min(kMaxCells, std::max<std::size_t>(std::size_t{1} << 16, 16 * n));
+  }
 
   /// Sorts particles into cells of size >= `min_cell_size` (give 2 max(h)). After this call, the store
   /// must be gathered through order() before cell ranges refer to it.
@@ -41,8 +46,10 @@ class CellGrid {
     Box init{VecD::Constant(inf), VecD::Constant(-inf)};
     Box box = par::reduce(
         n, init,
-        // A NaN would vanish in min/max; map any non-finite position to an infinite box so it is caught below.
-        [&](std::size_t i) { return x[i].allFinite() ? Box{x[i], x[i]} : Box{VecD::Constant(-inf), VecD::Constant(inf)}; },
+        // A NaN would vanish in min/max: any non-finite position maps to an infinite box, caught below.
+        [&](std::size_t i) {
+          return x[i].allFinite() ? Box{x[i], x[i]} : Box{VecD::Constant(-inf), VecD::Constant(inf)};
+        },
         [](const Box& a, const Box& b) { return Box{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)}; });
     if (n == 0) box = Box{VecD::Zero(), VecD::Zero()};
     for (int k = 0; k < D; ++k) {
@@ -60,7 +67,7 @@ class CellGrid {
         dims_[k] = static_cast<std::int64_t>(std::floor((box.hi[k] - box.lo[k]) / cell_size_)) + 1;
         total *= static_cast<std::size_t>(dims_[k]);
       }
-      if (total <= kMaxCells) {
+      if (total <= cell_budget(n)) {
         cells_ = total;
         break;
       }
