@@ -16,6 +16,7 @@ struct TankSpec {
   double h_factor = 1.2;
   double mach_factor = 10.0;  // c0 = mach_factor * sqrt(g depth)
   bool lennard_jones = false;
+  GhostPressure ghost_pressure = GhostPressure::hydrostatic;
 };
 
 struct DamBreakSpec {

@@ -8,7 +8,10 @@
 namespace sph {
 
 Simulation::Simulation(SolverSettings settings) : settings_(std::move(settings)) {
-  if (settings_.ghosts) ghosts_.emplace(settings_.geometry.walls(), *settings_.ghosts);
+  if (settings_.ghosts) {
+    ghosts_.emplace(settings_.geometry.walls(), *settings_.ghosts, settings_.ghost_pressure,
+                    settings_.gravity.value_or(Vec<2>::Zero()), settings_.eos);
+  }
   sweep_ = make_sweep(settings_);
 }
 

@@ -28,6 +28,7 @@ struct SolverSettings {
   std::optional<ViscositySettings> viscosity = ViscositySettings{};
   std::optional<LennardJonesSettings> lennard_jones;
   std::optional<GhostSlip> ghosts = GhostSlip::free_slip;
+  GhostPressure ghost_pressure = GhostPressure::hydrostatic;
   Geometry2 geometry;
   double cfl = 0.2;
   double dt_max = 1.0;  // upper bound on the step (s)

@@ -143,7 +143,7 @@ TEST(Parallel, ExclusiveScanOfDoublesIsBitwiseIdenticalAtAnyThreadCount) {
 /// Reference: std::stable_sort of the indices by key, and bucket starts from the counts.
 par::CountingSortResult reference_sort(const std::vector<std::uint32_t>& keys, std::size_t buckets) {
   par::CountingSortResult r;
-  r.order.resize(keys.size());
+  r.order.assign(keys.size(), 0u);
   std::iota(r.order.begin(), r.order.end(), 0u);
   std::stable_sort(r.order.begin(), r.order.end(),
                    [&](std::uint32_t a, std::uint32_t b) { return keys[a] < keys[b]; });

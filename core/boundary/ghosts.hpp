@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/boundary/wall.hpp"
+#include "core/equation_of_state.hpp"
 #include "core/particle_store.hpp"
 #include "parallel/compaction.hpp"
 
@@ -17,12 +18,19 @@ namespace sph {
 
 enum class GhostSlip { free_slip, no_slip };
 
+/// The pressure a ghost carries: the source's (PHYSICS.md, section 2.4 of the paper), or the source's plus
+/// the hydrostatic difference rho_i g.(x_ghost - x_i), with the density from the inverse equation of
+/// state (an option: it removes the excess pressure of the first layer above a horizontal wall).
+enum class GhostPressure { mirrored, hydrostatic };
+
 class GhostBuilder {
  public:
   /// Up to two walls and one corner per particle (the container's corners).
   static constexpr int kMaxGhosts = 3;
 
-  GhostBuilder(std::vector<Wall2> walls, GhostSlip slip) : walls_(std::move(walls)), slip_(slip) {}
+  GhostBuilder(std::vector<Wall2> walls, GhostSlip slip, GhostPressure pressure = GhostPressure::mirrored,
+               Vec<2> gravity = Vec<2>::Zero(), TaitEquationOfState eos = {})
+      : walls_(std::move(walls)), slip_(slip), pressure_(pressure), gravity_(std::move(gravity)), eos_(eos) {}
 
   const std::vector<Wall2>& walls() const { return walls_; }
   GhostSlip slip() const { return slip_; }
@@ -70,6 +78,10 @@ class GhostBuilder {
   /// Turns item k, a copy of its source particle, into that source's ghost number `image` (0-based).
   void make_ghost(ParticleView<2>& s, std::size_t k, int image) const {
     const Images im = images(s.x[k], s.v[k], s.h[k]);
+    if (pressure_ == GhostPressure::hydrostatic) {
+      s.p[k] += s.rho[k] * gravity_.dot(im.x[static_cast<std::size_t>(image)] - s.x[k]);
+      s.rho[k] = eos_.density(s.p[k]);
+    }
     s.x[k] = im.x[static_cast<std::size_t>(image)];
     s.v[k] = im.v[static_cast<std::size_t>(image)];
     s.kind[k] = Kind::ghost;
@@ -125,6 +137,9 @@ class GhostBuilder {
 
   std::vector<Wall2> walls_;
   GhostSlip slip_;
+  GhostPressure pressure_;
+  Vec<2> gravity_;
+  TaitEquationOfState eos_;
 };
 
 }  // namespace sph
