@@ -7,12 +7,15 @@
 #include <cmath>
 #include <random>
 
+#include "core/allocator_tuning.hpp"
 #include "core/case_builder.hpp"
 #include "core/refinement/split_pass.hpp"
 
 namespace {
 
 using namespace sph;
+
+const bool tuned = (tune_allocator(), true);
 
 // A dam-break block with about n fluid particles, rates evaluated (the state a pass sees between steps).
 Simulation block(std::size_t n) {

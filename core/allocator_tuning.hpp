@@ -1,0 +1,15 @@
+#pragma once
+// Keeps large freed blocks in the heap instead of returning them to the kernel. The solver's per-pass
+// workspaces (refinement, output) are tens of megabytes at 1e6 particles; with glibc's defaults each one is
+// a fresh mmap whose pages fault in on first touch, which made a split pass cost 2-10x more and vary from
+// run to run. Call once at program start (the app and the benchmarks do).
+#include <malloc.h>
+
+namespace sph {
+
+inline void tune_allocator() {
+  mallopt(M_MMAP_THRESHOLD, 1 << 30);  // serve large blocks from the heap
+  mallopt(M_TRIM_THRESHOLD, -1);       // and do not give the top of the heap back
+}
+
+}  // namespace sph
