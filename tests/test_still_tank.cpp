@@ -1,0 +1,122 @@
+// Still water in a tank (make_still_tank: 25 m wide, 10 m deep, ghost walls, gravity) stays still and
+// hydrostatic over 10 s of physical time, at the paper's spacing d = 25/30 m and at d/2.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <sstream>
+#include <string>
+
+#include "core/case_builder.hpp"
+#include "tests/support/physics_helpers.hpp"
+
+namespace {
+
+using sph::Kind;
+using sph::Vec;
+
+constexpr double kG = 9.81;
+
+struct TankState {
+  double max_speed = 0.0;
+  double max_density_error = 0.0;
+  double p_mid = 0.0, p_mid_expected = 0.0;        // band at mid-depth
+  double p_bottom = 0.0, p_bottom_expected = 0.0;  // band along the bottom
+  std::size_t n_mid = 0, n_bottom = 0;
+  std::size_t outside = 0;  // particles inside a wall or outside the container
+  std::size_t fluid = 0;
+  double min_y = 0.0, max_y = 0.0;
+  std::string describe() const {
+    std::ostringstream o;
+    o << "max|v| = " << max_speed << ", max density error = " << max_density_error << ", p_mid = " << p_mid
+      << " (hydrostatic " << p_mid_expected << ", " << n_mid << " particles), p_bottom = " << p_bottom
+      << " (hydrostatic " << p_bottom_expected << ", " << n_bottom << " particles), outside = " << outside
+      << ", y in [" << min_y << ", " << max_y << "]";
+    return o.str();
+  }
+};
+
+/// Averages p and rho0 g (depth - y) over the fluid particles in the band |y - y0| < half_width, away
+/// from the side walls (x in [width/5, 4 width/5]).
+void band(const sph::ParticleStore<2>& s, double y0, double half_width, double width, double depth, double rho0,
+          double& p, double& expected, std::size_t& count) {
+  p = expected = 0.0;
+  count = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] != Kind::fluid) continue;
+    const Vec<2>& x = s.x[i];
+    if (std::abs(x[1] - y0) >= half_width || x[0] < 0.2 * width || x[0] > 0.8 * width) continue;
+    p += s.p[i];
+    expected += rho0 * kG * (depth - x[1]);
+    ++count;
+  }
+  if (count > 0) {
+    p /= static_cast<double>(count);
+    expected /= static_cast<double>(count);
+  }
+}
+
+TankState measure(const sph::Simulation& sim, const sph::TankSpec& spec) {
+  const auto& s = sim.store();
+  const auto& st = sim.settings();
+  TankState out;
+  const auto d = sim.diagnostics();
+  out.max_speed = d.max_speed;
+  out.max_density_error = d.max_density_error;
+  out.fluid = d.fluid;
+  out.min_y = std::numeric_limits<double>::infinity();
+  out.max_y = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] != Kind::fluid) continue;
+    if (!st.geometry.in_fluid_domain(s.x[i]) || s.x[i][1] > st.geometry.container.hi[1]) ++out.outside;
+    out.min_y = std::min(out.min_y, s.x[i][1]);
+    out.max_y = std::max(out.max_y, s.x[i][1]);
+  }
+  band(s, 0.5 * spec.depth, spec.spacing, spec.width, spec.depth, st.eos.rho0, out.p_mid, out.p_mid_expected,
+       out.n_mid);
+  band(s, 0.5 * spec.spacing, spec.spacing, spec.width, spec.depth, st.eos.rho0, out.p_bottom,
+       out.p_bottom_expected, out.n_bottom);
+  return out;
+}
+
+void run_still_tank(double spacing) {
+  sph::TankSpec spec;
+  spec.spacing = spacing;
+  sph::Simulation sim = sph::make_still_tank(spec);
+  const double mass0 = sph::test::mass_by_id(sim.store());
+  const std::size_t fluid0 = sim.diagnostics().fluid;
+  const TankState start = measure(sim, spec);
+  ASSERT_EQ(start.outside, 0u) << start.describe();
+
+  const double t_end = 10.0;
+  double max_speed_seen = 0.0;
+  while (sim.time() < t_end * (1.0 - 1e-14)) {
+    sim.step(t_end - sim.time());
+    max_speed_seen = std::max(max_speed_seen, sim.diagnostics().max_speed);
+    ASSERT_TRUE(std::isfinite(sim.dt()) && sim.dt() > 0.0) << "t = " << sim.time();
+  }
+  sim.remove_ghosts();
+  const TankState end = measure(sim, spec);
+  const double v_ref = std::sqrt(kG * spec.depth);
+  SCOPED_TRACE("d = " + std::to_string(spacing) + ", " + std::to_string(sim.step_count()) + " steps: " +
+               end.describe() + ", max|v| over the run = " + std::to_string(max_speed_seen));
+
+  EXPECT_EQ(end.fluid, fluid0);
+  EXPECT_EQ(sph::test::mass_by_id(sim.store()), mass0);
+  EXPECT_TRUE(sph::test::all_finite(sim.store()));
+  EXPECT_LT(end.max_speed, 0.05 * v_ref);
+  ASSERT_GT(end.n_mid, 10u);
+  ASSERT_GT(end.n_bottom, 10u);
+  EXPECT_NEAR(end.p_mid, end.p_mid_expected, 0.05 * end.p_mid_expected);
+  EXPECT_NEAR(end.p_bottom, end.p_bottom_expected, 0.05 * end.p_bottom_expected);
+  EXPECT_LT(end.max_density_error, 0.02);
+  EXPECT_EQ(end.outside, 0u);
+}
+
+TEST(StillTank, StaysStillAndHydrostaticAtPaperSpacing) { run_still_tank(25.0 / 30.0); }
+
+TEST(StillTank, StaysStillAndHydrostaticAtHalfSpacing) { run_still_tank(25.0 / 60.0); }
+
+}  // namespace
