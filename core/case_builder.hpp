@@ -23,7 +23,7 @@ struct DamBreakSpec {
   double column_width = 25.0;
   double column_height = 25.0;
   double tank_width = 50.0;   // the obstacle at x = 50 m is the container's right wall
-  double tank_height = 40.0;  // walls reach this high (open top)
+  double tank_height = 80.0;  // walls reach this high (open top): the jet up the right wall reaches ~50 m
   double spacing = 25.0 / 30.0;
   double h_factor = 1.2;
   double mach_factor = 10.0;  // c0 = mach_factor * sqrt(2 g H0)
