@@ -1,35 +1,50 @@
-// sphrefine: command-line front end (thin over core/).
-#include <chrono>
-#include <cstdio>
-#include <cstring>
-#include <string>
+// sphrefine: the command-line program, thin over core/ (see app/commands.hpp for the exit codes).
+//   sphrefine run SCENE [-o DIR] [--threads N] [--set key.path=value ...] [--force]
+//                       [--checkpoint-every T] [--resume CHECKPOINT] [--quiet]
+//   sphrefine validate SCENE [--set key.path=value ...]
+//   sphrefine info
+#include <CLI/CLI.hpp>
 
-#include "core/case_builder.hpp"
+#include "app/commands.hpp"
 
 int main(int argc, char** argv) {
-  const std::string name = argc > 1 ? argv[1] : "dam_break";
-  if (name != "dam_break") {
-    std::fprintf(stderr, "sphrefine: unknown case '%s'\n", name.c_str());
-    return 2;
+  CLI::App app{"sphrefine: weakly-compressible SPH with dynamic particle refinement"};
+  app.require_subcommand(1);
+
+  sph::app::RunArguments run;
+  CLI::App* run_cmd = app.add_subcommand("run", "Run a scene file to its end time, writing its outputs");
+  run_cmd->add_option("scene", run.scene, "Scene file (JSON, docs/SCENES.md)")->required();
+  run_cmd->add_option("-o,--output", run.output, "Output folder (default: output.folder, else out/<name>)");
+  run_cmd->add_option("--threads", run.threads, "OpenMP threads (default: OMP_NUM_THREADS or all)")
+      ->check(CLI::PositiveNumber);
+  run_cmd->add_option("--set", run.overrides, "Override a scene key before validation: key.path=value (repeatable)")
+      ->expected(1)
+      ->take_all();
+  run_cmd->add_flag("--force", run.force, "Overwrite an output folder that already holds a run");
+  run_cmd->add_option("--checkpoint-every", run.checkpoint_every,
+                      "Write <output>/checkpoint.h5 every T simulated seconds and at the end")
+      ->check(CLI::PositiveNumber);
+  run_cmd->add_option("--resume", run.resume, "Continue the run in the output folder from this checkpoint");
+  run_cmd->add_flag("-q,--quiet", run.quiet, "No progress line and no banner");
+
+  std::string validate_scene;
+  std::vector<std::string> validate_overrides;
+  CLI::App* validate_cmd = app.add_subcommand("validate", "Check a scene file and report what it sets up; writes nothing");
+  validate_cmd->add_option("scene", validate_scene, "Scene file (JSON)")->required();
+  validate_cmd->add_option("--set", validate_overrides, "Override a scene key: key.path=value (repeatable)")
+      ->expected(1)
+      ->take_all();
+
+  CLI::App* info_cmd = app.add_subcommand("info", "Version, build type, threads and library versions");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : sph::app::kExitUsage;
   }
-  sph::DamBreakSpec spec;
-  sph::Simulation sim = sph::make_dam_break(spec);
-  const double H0 = spec.column_height, g = 9.81;
-  const double t_end = 2.0 * std::sqrt(H0 / g);
-  const auto t0 = std::chrono::steady_clock::now();
-  double next_print = 0.0;
-  while (sim.time() < t_end) {
-    sim.step(t_end - sim.time());
-    sim.run_stages();
-    if (sim.time() >= next_print) {
-      const auto d = sim.diagnostics();
-      std::printf("t*=%.3f step=%llu dt=%.3e fluid=%zu ghosts=%zu |v|max=%.3f drho=%.4f mass=%.6e\n",
-                  sim.time() / std::sqrt(H0 / g), static_cast<unsigned long long>(d.step), d.dt, d.fluid,
-                  d.ghosts, d.max_speed, d.max_density_error, d.mass);
-      next_print += 0.1 * std::sqrt(H0 / g);
-    }
-  }
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("done: %llu steps in %.3f s\n", static_cast<unsigned long long>(sim.step_count()), wall);
-  return 0;
+  if (run_cmd->parsed()) return sph::app::run_command(run);
+  if (validate_cmd->parsed()) return sph::app::validate_command(validate_scene, validate_overrides);
+  if (info_cmd->parsed()) return sph::app::info_command();
+  return sph::app::kExitUsage;
 }

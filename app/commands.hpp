@@ -1,0 +1,30 @@
+#pragma once
+// The program's commands, thin over core/: run, validate, info. Each returns the process exit code:
+//   0 success, 1 the run failed (diverged, I/O), 2 a scene or command-line error (nothing created),
+//   3 the output folder already holds a run (use --force).
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace sph::app {
+
+inline constexpr int kExitFailure = 1;
+inline constexpr int kExitUsage = 2;
+inline constexpr int kExitFolderHoldsRun = 3;
+
+struct RunArguments {
+  std::string scene;
+  std::string output;
+  int threads = 0;
+  std::vector<std::string> overrides;
+  bool force = false;
+  std::string resume;
+  double checkpoint_every = 0.0;
+  bool quiet = false;
+};
+
+int run_command(const RunArguments& args);
+int validate_command(const std::string& scene, const std::vector<std::string>& overrides);
+int info_command();
+
+}  // namespace sph::app

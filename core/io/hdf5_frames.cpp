@@ -1,0 +1,297 @@
+#include "core/io/hdf5_frames.hpp"
+
+#include <hdf5.h>
+
+#include <algorithm>
+#include <stdexcept>
+#include <type_traits>
+
+#include "core/io/atomic_file.hpp"
+
+namespace sph::io {
+
+namespace {
+
+constexpr hid_t kDefault = 0;  // H5P_DEFAULT
+constexpr const char* kCheckpointGroup = "checkpoint";
+constexpr std::uint64_t kCheckpointFormat = 1;
+
+/// Silences HDF5's own error printing once: failures become exceptions with a message of ours.
+void quiet_hdf5() {
+  static const bool done = [] {
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+    return true;
+  }();
+  (void)done;
+}
+
+/// An HDF5 identifier closed on scope exit.
+class Handle {
+ public:
+  using Close = herr_t (*)(hid_t);
+  Handle(hid_t id, Close close, const std::string& what) : id_(id), close_(close) {
+    if (id_ < 0) throw std::runtime_error("HDF5: cannot " + what);
+  }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  ~Handle() {
+    if (id_ >= 0) close_(id_);
+  }
+  operator hid_t() const { return id_; }  // NOLINT: used as the id it wraps
+
+ private:
+  hid_t id_;
+  Close close_;
+};
+
+void check(herr_t status, const std::string& what) {
+  if (status < 0) throw std::runtime_error("HDF5: cannot " + what);
+}
+
+/// Per value type: the HDF5 memory type, the scalar element and components per particle.
+template <class T>
+struct H5Traits;
+template <>
+struct H5Traits<double> {
+  static hid_t type() { return H5T_NATIVE_DOUBLE; }
+  static constexpr int components = 1;
+  static FieldLayout layout(std::string n) { return {std::move(n), "Float", 8, 1}; }
+};
+template <>
+struct H5Traits<Vec<2>> {
+  static hid_t type() { return H5T_NATIVE_DOUBLE; }
+  static constexpr int components = 2;
+  static FieldLayout layout(std::string n) { return {std::move(n), "Float", 8, 2}; }
+};
+template <>
+struct H5Traits<std::int32_t> {
+  static hid_t type() { return H5T_NATIVE_INT32; }
+  static constexpr int components = 1;
+  static FieldLayout layout(std::string n) { return {std::move(n), "Int", 4, 1}; }
+};
+template <>
+struct H5Traits<Kind> {
+  static_assert(sizeof(Kind) == 1);
+  static hid_t type() { return H5T_NATIVE_UINT8; }
+  static constexpr int components = 1;
+  static FieldLayout layout(std::string n) { return {std::move(n), "UChar", 1, 1}; }
+};
+template <>
+struct H5Traits<std::uint64_t> {
+  static hid_t type() { return H5T_NATIVE_UINT64; }
+  static constexpr int components = 1;
+  static FieldLayout layout(std::string n) { return {std::move(n), "UInt", 8, 1}; }
+};
+
+template <class T>
+void write_attribute(hid_t object, const char* name, hid_t type, const T& value) {
+  const Handle space(H5Screate(H5S_SCALAR), H5Sclose, "create a dataspace");
+  const Handle attr(H5Acreate2(object, name, type, space, kDefault, kDefault), H5Aclose,
+                    std::string("create attribute ") + name);
+  check(H5Awrite(attr, type, &value), std::string("write attribute ") + name);
+}
+
+void write_string_attribute(hid_t object, const char* name, const std::string& value) {
+  const Handle type(H5Tcopy(H5T_C_S1), H5Tclose, "copy the string type");
+  check(H5Tset_size(type, std::max<std::size_t>(1, value.size())), "size a string type");
+  const Handle space(H5Screate(H5S_SCALAR), H5Sclose, "create a dataspace");
+  const Handle attr(H5Acreate2(object, name, type, space, kDefault, kDefault), H5Aclose,
+                    std::string("create attribute ") + name);
+  std::string padded = value;
+  if (padded.empty()) padded.push_back('\0');
+  check(H5Awrite(attr, type, padded.data()), std::string("write attribute ") + name);
+}
+
+template <class T>
+T read_attribute(hid_t object, const char* name, hid_t type) {
+  const Handle attr(H5Aopen(object, name, kDefault), H5Aclose, std::string("open attribute ") + name);
+  T value{};
+  check(H5Aread(attr, type, &value), std::string("read attribute ") + name);
+  return value;
+}
+
+std::string read_string_attribute(hid_t object, const char* name) {
+  const Handle attr(H5Aopen(object, name, kDefault), H5Aclose, std::string("open attribute ") + name);
+  const Handle type(H5Aget_type(attr), H5Tclose, "get an attribute type");
+  const std::size_t size = H5Tget_size(type);
+  std::string value(size, '\0');
+  const Handle mem(H5Tcopy(H5T_C_S1), H5Tclose, "copy the string type");
+  check(H5Tset_size(mem, size), "size a string type");
+  check(H5Aread(attr, mem, value.data()), std::string("read attribute ") + name);
+  while (!value.empty() && value.back() == '\0') value.pop_back();
+  return value;
+}
+
+bool has_attribute(hid_t object, const char* name) { return H5Aexists(object, name) > 0; }
+
+template <class T>
+void write_dataset(hid_t group, const std::string& name, const std::vector<T>& values) {
+  using Tr = H5Traits<T>;
+  const hsize_t dims[2] = {values.size(), static_cast<hsize_t>(Tr::components)};
+  const Handle space(H5Screate_simple(Tr::components > 1 ? 2 : 1, dims, nullptr), H5Sclose, "create a dataspace");
+  const Handle set(H5Dcreate2(group, name.c_str(), Tr::type(), space, kDefault, kDefault, kDefault), H5Dclose,
+                   "create dataset " + name);
+  if (!values.empty()) check(H5Dwrite(set, Tr::type(), H5S_ALL, H5S_ALL, kDefault, values.data()), "write dataset " + name);
+}
+
+template <class T>
+void read_dataset(hid_t group, const std::string& name, std::vector<T>& values) {
+  using Tr = H5Traits<T>;
+  const Handle set(H5Dopen2(group, name.c_str(), kDefault), H5Dclose, "open dataset " + name);
+  const Handle space(H5Dget_space(set), H5Sclose, "get the dataspace of " + name);
+  const int rank = H5Sget_simple_extent_ndims(space);
+  hsize_t dims[2] = {0, 1};
+  if (rank < 1 || rank > 2 || H5Sget_simple_extent_dims(space, dims, nullptr) < 0) {
+    throw std::runtime_error("HDF5: dataset " + name + " has an unexpected shape");
+  }
+  if (static_cast<int>(rank == 2 ? dims[1] : 1) != Tr::components) {
+    throw std::runtime_error("HDF5: dataset " + name + " has the wrong number of components");
+  }
+  values.resize(dims[0], zero_value<T>());
+  if (!values.empty()) check(H5Dread(set, Tr::type(), H5S_ALL, H5S_ALL, kDefault, values.data()), "read dataset " + name);
+}
+
+std::vector<std::size_t> non_ghosts(const ParticleStore<2>& store) {
+  std::vector<std::size_t> keep;
+  keep.reserve(store.size());
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    if (store.kind[i] != Kind::ghost) keep.push_back(i);
+  }
+  return keep;
+}
+
+template <class T>
+std::vector<T> gathered(const Field<T>& f, const std::vector<std::size_t>& keep) {
+  std::vector<T> out(keep.size(), zero_value<T>());
+  for (std::size_t k = 0; k < keep.size(); ++k) out[k] = f[keep[k]];
+  return out;
+}
+
+bool wanted(const std::vector<std::string>& fields, std::string_view name) {
+  return fields.empty() || name == "position" || std::find(fields.begin(), fields.end(), name) != fields.end();
+}
+
+}  // namespace
+
+std::vector<FieldLayout> field_layouts() {
+  std::vector<FieldLayout> out;
+  const ParticleStore<2> store;
+  store.for_each_field([&](const auto& f) {
+    using T = typename std::decay_t<decltype(f)>::value_type;
+    out.push_back(H5Traits<T>::layout(std::string(f.name())));
+  });
+  return out;
+}
+
+FrameHeader write_frame(const std::filesystem::path& file, const std::string& group, const ParticleStore<2>& store,
+                        double time, std::uint64_t step, std::uint64_t index, const std::vector<std::string>& fields) {
+  quiet_hdf5();
+  const std::vector<std::size_t> keep = non_ghosts(store);
+  FrameHeader header{group, time, step, index, keep.size(), {}};
+  const std::filesystem::path tmp = temporary_path(file);
+  {
+    const Handle f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, kDefault, kDefault), H5Fclose, "create " + tmp.string());
+    const Handle g(H5Gcreate2(f, group.c_str(), kDefault, kDefault, kDefault), H5Gclose, "create group " + group);
+    write_attribute(g, "time", H5T_NATIVE_DOUBLE, time);
+    write_attribute(g, "step", H5T_NATIVE_UINT64, step);
+    write_attribute(g, "frame", H5T_NATIVE_UINT64, index);
+    write_attribute(g, "particles", H5T_NATIVE_UINT64, header.particles);
+    store.for_each_field([&](const auto& field) {
+      if (!wanted(fields, field.name())) return;
+      using T = typename std::decay_t<decltype(field)>::value_type;
+      write_dataset(g, std::string(field.name()), gathered(field, keep));
+      header.fields.push_back(H5Traits<T>::layout(std::string(field.name())));
+    });
+  }
+  commit_file(file);
+  return header;
+}
+
+FrameHeader read_frame_header(const std::filesystem::path& file, const std::string& group) {
+  quiet_hdf5();
+  const Handle f(H5Fopen(file.c_str(), H5F_ACC_RDONLY, kDefault), H5Fclose, "open " + file.string());
+  const Handle g(H5Gopen2(f, group.c_str(), kDefault), H5Gclose, "open group " + group + " in " + file.string());
+  FrameHeader h;
+  h.group = group;
+  h.time = read_attribute<double>(g, "time", H5T_NATIVE_DOUBLE);
+  h.step = read_attribute<std::uint64_t>(g, "step", H5T_NATIVE_UINT64);
+  h.index = read_attribute<std::uint64_t>(g, "frame", H5T_NATIVE_UINT64);
+  h.particles = read_attribute<std::uint64_t>(g, "particles", H5T_NATIVE_UINT64);
+  for (const FieldLayout& layout : field_layouts()) {
+    if (H5Lexists(g, layout.name.c_str(), kDefault) > 0) h.fields.push_back(layout);
+  }
+  return h;
+}
+
+std::vector<double> read_frame_field(const std::filesystem::path& file, const std::string& group, const std::string& field) {
+  quiet_hdf5();
+  const Handle f(H5Fopen(file.c_str(), H5F_ACC_RDONLY, kDefault), H5Fclose, "open " + file.string());
+  const Handle g(H5Gopen2(f, group.c_str(), kDefault), H5Gclose, "open group " + group);
+  const Handle set(H5Dopen2(g, field.c_str(), kDefault), H5Dclose, "open dataset " + field);
+  const Handle space(H5Dget_space(set), H5Sclose, "get the dataspace of " + field);
+  const hssize_t n = H5Sget_simple_extent_npoints(space);
+  if (n < 0) throw std::runtime_error("HDF5: cannot size dataset " + field);
+  std::vector<double> values(static_cast<std::size_t>(n));
+  if (n > 0) check(H5Dread(set, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, kDefault, values.data()), "read dataset " + field);
+  return values;
+}
+
+void write_checkpoint(const std::filesystem::path& file, const ParticleStore<2>& store, const CheckpointState& state) {
+  quiet_hdf5();
+  const std::vector<std::size_t> keep = non_ghosts(store);
+  const std::filesystem::path tmp = temporary_path(file);
+  {
+    const Handle f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, kDefault, kDefault), H5Fclose, "create " + tmp.string());
+    const Handle g(H5Gcreate2(f, kCheckpointGroup, kDefault, kDefault, kDefault), H5Gclose, "create the checkpoint group");
+    write_attribute(g, "format", H5T_NATIVE_UINT64, kCheckpointFormat);
+    write_attribute(g, "time", H5T_NATIVE_DOUBLE, state.time);
+    write_attribute(g, "step", H5T_NATIVE_UINT64, state.step);
+    write_attribute(g, "dt", H5T_NATIVE_DOUBLE, state.dt);
+    write_attribute(g, "next_id", H5T_NATIVE_UINT64, state.next_id);
+    write_attribute(g, "next_row", H5T_NATIVE_UINT64, state.next_row);
+    write_attribute(g, "next_frame", H5T_NATIVE_UINT64, state.next_frame);
+    write_attribute(g, "frame_count", H5T_NATIVE_UINT64, state.frame_count);
+    write_attribute(g, "next_checkpoint", H5T_NATIVE_UINT64, state.next_checkpoint);
+    write_attribute(g, "particle_steps", H5T_NATIVE_UINT64, state.particle_steps);
+    write_attribute(g, "initial_mass", H5T_NATIVE_DOUBLE, state.initial_mass);
+    write_attribute(g, "initial_momentum_x", H5T_NATIVE_DOUBLE, state.initial_momentum_x);
+    write_attribute(g, "initial_momentum_y", H5T_NATIVE_DOUBLE, state.initial_momentum_y);
+    write_attribute(g, "particles", H5T_NATIVE_UINT64, static_cast<std::uint64_t>(keep.size()));
+    write_string_attribute(g, "scene", state.scene);
+    store.for_each_field([&](const auto& field) { write_dataset(g, std::string(field.name()), gathered(field, keep)); });
+  }
+  commit_file(file);
+}
+
+CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore<2>& store) {
+  quiet_hdf5();
+  const Handle f(H5Fopen(file.c_str(), H5F_ACC_RDONLY, kDefault), H5Fclose, "open " + file.string());
+  const Handle g(H5Gopen2(f, kCheckpointGroup, kDefault), H5Gclose, file.string() + " is not a checkpoint");
+  if (!has_attribute(g, "format") || read_attribute<std::uint64_t>(g, "format", H5T_NATIVE_UINT64) != kCheckpointFormat) {
+    throw std::runtime_error(file.string() + ": unsupported checkpoint format");
+  }
+  CheckpointState s;
+  s.time = read_attribute<double>(g, "time", H5T_NATIVE_DOUBLE);
+  s.step = read_attribute<std::uint64_t>(g, "step", H5T_NATIVE_UINT64);
+  s.dt = read_attribute<double>(g, "dt", H5T_NATIVE_DOUBLE);
+  s.next_id = read_attribute<std::uint64_t>(g, "next_id", H5T_NATIVE_UINT64);
+  s.next_row = read_attribute<std::uint64_t>(g, "next_row", H5T_NATIVE_UINT64);
+  s.next_frame = read_attribute<std::uint64_t>(g, "next_frame", H5T_NATIVE_UINT64);
+  s.frame_count = read_attribute<std::uint64_t>(g, "frame_count", H5T_NATIVE_UINT64);
+  s.next_checkpoint = read_attribute<std::uint64_t>(g, "next_checkpoint", H5T_NATIVE_UINT64);
+  s.particle_steps = read_attribute<std::uint64_t>(g, "particle_steps", H5T_NATIVE_UINT64);
+  s.initial_mass = read_attribute<double>(g, "initial_mass", H5T_NATIVE_DOUBLE);
+  s.initial_momentum_x = read_attribute<double>(g, "initial_momentum_x", H5T_NATIVE_DOUBLE);
+  s.initial_momentum_y = read_attribute<double>(g, "initial_momentum_y", H5T_NATIVE_DOUBLE);
+  s.scene = read_string_attribute(g, "scene");
+  const auto n = read_attribute<std::uint64_t>(g, "particles", H5T_NATIVE_UINT64);
+  store.clear();
+  store.for_each_field([&](auto& field) {
+    read_dataset(g, std::string(field.name()), field.values());
+    if (field.size() != n) throw std::runtime_error(file.string() + ": field " + std::string(field.name()) + " has the wrong size");
+  });
+  store.set_next_id(s.next_id);
+  return s;
+}
+
+}  // namespace sph::io

@@ -1,0 +1,73 @@
+#pragma once
+// HDF5 frames and checkpoints, written through the store's field registry so that no field is forgotten.
+//
+// A frame file holds one group (named like "frame_000012") with one dataset per particle field (named
+// after the field: "position" N x 2, "density" N, "level" N, ...) for every particle except ghosts, in
+// store order, and the attributes time (s), step, frame and particles. A checkpoint file holds group
+// "checkpoint" with every field and the whole state needed to continue bitwise identically. Every file
+// is written under a temporary name and renamed when complete (core/io/atomic_file.hpp).
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/particle_store.hpp"
+
+namespace sph::io {
+
+/// How one field is stored, as XDMF needs it: NumberType, Precision (bytes) and components per particle.
+struct FieldLayout {
+  std::string name;
+  std::string number_type;  // "Float", "Int", "UInt", "UChar"
+  int precision = 8;
+  int components = 1;
+  bool operator==(const FieldLayout&) const = default;
+};
+
+struct FrameHeader {
+  std::string group;
+  double time = 0.0;
+  std::uint64_t step = 0;
+  std::uint64_t index = 0;
+  std::uint64_t particles = 0;
+  std::vector<FieldLayout> fields;
+};
+
+/// The layout of every field of the store (in registry order).
+std::vector<FieldLayout> field_layouts();
+
+/// Writes the named fields (every field when empty; "position" always) of every non-ghost particle to a new
+/// HDF5 file, atomically. Returns what it wrote.
+FrameHeader write_frame(const std::filesystem::path& file, const std::string& group, const ParticleStore<2>& store,
+                        double time, std::uint64_t step, std::uint64_t index, const std::vector<std::string>& fields);
+
+/// The attributes and the datasets of a frame group.
+FrameHeader read_frame_header(const std::filesystem::path& file, const std::string& group);
+
+/// Reads one field of a frame: doubles (position and velocity come as x0, y0, x1, y1, ...).
+std::vector<double> read_frame_field(const std::filesystem::path& file, const std::string& group, const std::string& field);
+
+/// Everything a checkpoint restores besides the particles.
+struct CheckpointState {
+  double time = 0.0;
+  std::uint64_t step = 0;
+  double dt = 0.0;
+  std::uint64_t next_id = 0;
+  std::uint64_t next_row = 0;    // the time-series row counter of the run
+  std::uint64_t next_frame = 0;  // the frame time slot of the run (next frame at next_frame * interval)
+  std::uint64_t frame_count = 0; // frames written (the next frame file's number)
+  std::uint64_t next_checkpoint = 0;
+  std::uint64_t particle_steps = 0;
+  double initial_mass = 0.0;      // the run's state at t = 0, for the drift in the summary
+  double initial_momentum_x = 0.0;
+  double initial_momentum_y = 0.0;
+  std::string scene;             // the scene (JSON) the run was started from
+};
+
+/// Writes every field of every non-ghost particle and the state, atomically.
+void write_checkpoint(const std::filesystem::path& file, const ParticleStore<2>& store, const CheckpointState& state);
+
+/// Reads a checkpoint into `store` (replacing its particles and next id). Throws std::runtime_error.
+CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore<2>& store);
+
+}  // namespace sph::io

@@ -1,0 +1,83 @@
+#include "core/scene/probes.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "core/kernel.hpp"
+
+namespace sph::scene {
+
+namespace {
+
+/// max(y_i + d_i/2) over the fluid column |x_i - x| <= band, or -infinity when it is dry.
+double column_top(const ParticleStore<2>& store, double x, double band) {
+  double top = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    if (store.kind[i] != Kind::fluid || std::abs(store.x[i][0] - x) > band) continue;
+    top = std::max(top, store.x[i][1] + 0.5 * store.d[i]);
+  }
+  return top;
+}
+
+}  // namespace
+
+double water_height(const ParticleStore<2>& store, double x, double band, double floor) {
+  const double top = column_top(store, x, band);
+  return std::isfinite(top) ? top - floor : 0.0;
+}
+
+double surge_front(const ParticleStore<2>& store, double origin) {
+  double front = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    if (store.kind[i] == Kind::fluid) front = std::max(front, store.x[i][0] + 0.5 * store.d[i]);
+  }
+  return std::isfinite(front) ? front - origin : 0.0;
+}
+
+double point_pressure(const ParticleStore<2>& store, const Vec<2>& point) {
+  double num = 0.0, den = 0.0;
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    if (store.kind[i] == Kind::wall || !(store.rho[i] > 0.0)) continue;
+    const double r = (store.x[i] - point).norm();
+    if (r >= 2.0 * store.h[i]) continue;
+    const double w = store.m[i] / store.rho[i] * CubicSpline<2>::value(r, store.h[i]);
+    num += w * store.p[i];
+    den += w;
+  }
+  return den > 0.0 ? num / den : 0.0;
+}
+
+Probes::Probes(const Scene& scene) {
+  const double band = coarsest_spacing(scene);
+  for (const Probe& p : scene.probes) {
+    Resolved r{p.kind, p.x, p.band.value_or(band), 0.0, p.position};
+    switch (p.kind) {
+      case ProbeKind::water_height: r.reference = scene.container.box.lo[1]; break;
+      case ProbeKind::surface_elevation: r.reference = p.datum; break;
+      case ProbeKind::surge_front: r.reference = p.origin.value_or(scene.container.box.lo[0]); break;
+      case ProbeKind::pressure: break;
+    }
+    probes_.push_back(r);
+    names_.push_back(p.name);
+  }
+}
+
+std::vector<double> Probes::measure(const ParticleStore<2>& store) const {
+  std::vector<double> out;
+  out.reserve(probes_.size());
+  for (const Resolved& p : probes_) {
+    switch (p.kind) {
+      case ProbeKind::water_height: out.push_back(water_height(store, p.x, p.band, p.reference)); break;
+      case ProbeKind::surface_elevation: {
+        const double top = column_top(store, p.x, p.band);
+        out.push_back(std::isfinite(top) ? top - p.reference : std::numeric_limits<double>::quiet_NaN());
+        break;
+      }
+      case ProbeKind::surge_front: out.push_back(surge_front(store, p.reference)); break;
+      case ProbeKind::pressure: out.push_back(point_pressure(store, p.position)); break;
+    }
+  }
+  return out;
+}
+
+}  // namespace sph::scene

@@ -1,0 +1,40 @@
+#pragma once
+// Probes: measurements of the fluid written to the time series (docs/SCENES.md, "probes").
+//   water_height       H = max(y_i + d_i/2) - floor over fluid particles with |x_i - x| <= band
+//                      (the paper's H(t) at a wall; H = H0 at t = 0 for a lattice column)
+//   surface_elevation  max(y_i + d_i/2) - datum over the same column (NaN when the column is dry)
+//   surge_front        Z = max(x_i + d_i/2) - origin over every fluid particle (the paper's Z(t))
+//   pressure           Shepard-normalised SPH interpolation of p at a point over fluid and ghost particles,
+//                      sum_j V_j p_j W(r, h_j) / sum_j V_j W(r, h_j), V_j = m_j / rho_j (0 when no particle
+//                      reaches the point)
+// Each probe is one pass over the store, run only at output times.
+#include <string>
+#include <vector>
+
+#include "core/particle_store.hpp"
+#include "core/scene/scene.hpp"
+
+namespace sph::scene {
+
+double water_height(const ParticleStore<2>& store, double x, double band, double floor);
+double surge_front(const ParticleStore<2>& store, double origin);
+double point_pressure(const ParticleStore<2>& store, const Vec<2>& point);
+
+class Probes {
+ public:
+  explicit Probes(const Scene& scene);
+  const std::vector<std::string>& names() const { return names_; }
+  /// One value per probe, in scene order.
+  std::vector<double> measure(const ParticleStore<2>& store) const;
+
+ private:
+  struct Resolved {
+    ProbeKind kind;
+    double x, band, reference;
+    Vec<2> position;
+  };
+  std::vector<Resolved> probes_;
+  std::vector<std::string> names_;
+};
+
+}  // namespace sph::scene

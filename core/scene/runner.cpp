@@ -1,0 +1,272 @@
+#include "core/scene/runner.hpp"
+
+#include <omp.h>
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "core/io/atomic_file.hpp"
+#include "core/io/hdf5_frames.hpp"
+#include "core/io/time_series.hpp"
+#include "core/scene/scene_builder.hpp"
+#include "core/scene/scene_parser.hpp"
+
+namespace sph::scene {
+
+namespace {
+
+constexpr double kTimeTolerance = 1e-9;  // relative to an interval: an output time reached up to rounding
+
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+/// The index of the first output strictly after time t.
+std::uint64_t next_index(double t, double interval) {
+  return static_cast<std::uint64_t>(std::floor(t / interval + kTimeTolerance)) + 1;
+}
+
+bool due(double t, std::uint64_t index, double interval) {
+  return t / interval >= static_cast<double>(index) - kTimeTolerance;
+}
+
+double frame_interval(const Scene& s) { return s.output.frame_interval.value_or(s.time.interval()); }
+
+/// The scene with what a resumed run may change (end time, outputs, probes, names) left out.
+Json physics_of(const Scene& s) {
+  Json j = scene_to_json(s);
+  for (const char* key : {"name", "description", "time", "probes", "output"}) j.erase(key);
+  return j;
+}
+
+}  // namespace
+
+Runner::Runner(Scene scene, RunOptions options)
+    : scene_(std::move(scene)),
+      options_(std::move(options)),
+      files_{options_.folder},
+      sim_(build_simulation(scene_)),
+      probes_(scene_) {
+  if (options_.resume) {
+    io::CheckpointState state = io::read_checkpoint(*options_.resume, sim_.store());
+    Scene original;
+    try {
+      original = scene_from_json(Json::parse(state.scene));
+    } catch (const std::exception&) {
+      throw SceneError("--resume", "the checkpoint does not hold a readable scene");
+    }
+    if (physics_of(original) != physics_of(scene_)) {
+      throw SceneError("--resume", "the checkpoint was written by a different scene (only time, probes and output may change)");
+    }
+    sim_.set_clock(state.time, state.step, state.dt);
+    next_row_ = state.next_row;
+    next_frame_ = state.next_frame;
+    frame_count_ = state.frame_count;
+    next_checkpoint_ = state.next_checkpoint;
+    particle_steps_ = state.particle_steps;
+    initial_mass_ = state.initial_mass;
+    initial_momentum_ = Vec<2>(state.initial_momentum_x, state.initial_momentum_y);
+    last_row_step_ = last_frame_step_ = last_checkpoint_step_ = state.step;
+    resumed_ = true;
+  } else {
+    const Diagnostics d = sim_.diagnostics();
+    initial_mass_ = d.mass;
+    initial_momentum_ = d.momentum;
+  }
+}
+
+Runner::~Runner() = default;
+
+bool Runner::finished() const { return !(sim_.time() < scene_.time.end * (1.0 - 1e-14)); }
+
+std::vector<std::string> Runner::columns() const {
+  std::vector<std::string> c{"time", "step", "dt", "fluid", "ghosts", "walls"};
+  for (int l = 0; l <= finest_level(scene_); ++l) c.push_back("level_" + std::to_string(l));
+  for (const char* name : {"mass", "momentum_x", "momentum_y", "angular_momentum", "kinetic", "potential", "elastic",
+                           "total_energy", "max_speed", "max_density_error"}) {
+    c.emplace_back(name);
+  }
+  for (const auto& n : probes_.names()) c.push_back(n);
+  return c;
+}
+
+std::size_t Runner::fluid_count() const {
+  const auto& kind = sim_.store().kind.values();
+  std::size_t n = 0;
+  for (const Kind k : kind) n += k == Kind::fluid ? 1 : 0;
+  return n;
+}
+
+void Runner::start() {
+  if (started_) return;
+  started_ = true;
+  wall_start_ = now_seconds();
+  if (options_.folder.empty()) return;
+  std::filesystem::create_directories(options_.folder);
+  if (scene_.output.frames) std::filesystem::create_directories(files_.frames());
+  if (resumed_) {
+    // Continue the files of the interrupted run: drop the rows written after the checkpoint, and list the
+    // frames written before it.
+    if (std::filesystem::exists(files_.series())) {
+      io::truncate_time_series(files_.series(), sim_.step_count());
+      series_ = std::make_unique<io::TimeSeriesWriter>(files_.series(), columns(), true);
+    } else {
+      series_ = std::make_unique<io::TimeSeriesWriter>(files_.series(), columns(), false);
+    }
+    for (std::uint64_t f = 0; f < frame_count_; ++f) {
+      const auto file = files_.frame(f);
+      if (!std::filesystem::exists(file)) continue;
+      frames_.push_back({"frames/" + io::RunFiles::frame_file_name(f), io::read_frame_header(file, io::RunFiles::frame_group(f))});
+    }
+    return;
+  }
+  io::write_file_atomic(files_.scene(), scene_to_json(scene_).dump(2) + "\n");
+  series_ = std::make_unique<io::TimeSeriesWriter>(files_.series(), columns(), false);
+  write_due_outputs(false);
+}
+
+void Runner::advance() {
+  if (!started_) start();
+  const double t0 = sim_.time();
+  try {
+    sim_.step(scene_.time.end - sim_.time());
+    sim_.run_stages();
+  } catch (const std::exception& e) {
+    throw std::runtime_error("the simulation failed at t = " + std::to_string(t0) + " s (step " +
+                             std::to_string(sim_.step_count()) + "): " + e.what());
+  }
+  const double dt = sim_.dt();
+  if (!std::isfinite(dt) || !(dt > scene_.time.end * 1e-12)) {
+    throw std::runtime_error("the simulation diverged at t = " + std::to_string(sim_.time()) + " s (step " +
+                             std::to_string(sim_.step_count()) + "): the next time step is " + std::to_string(dt) +
+                             " s; try a smaller time.cfl, a larger sound speed or more viscosity");
+  }
+  ++steps_run_;
+  particle_steps_ += fluid_count();
+  write_due_outputs(false);
+}
+
+void Runner::write_due_outputs(bool final) {
+  if (options_.folder.empty()) return;
+  const double t = sim_.time();
+  const std::uint64_t step = sim_.step_count();
+  const double interval = scene_.time.interval();
+  if (final ? last_row_step_ != step : due(t, next_row_, interval)) {
+    write_row();
+    next_row_ = next_index(t, interval);
+  }
+  if (scene_.output.frames && (final ? last_frame_step_ != step : due(t, next_frame_, frame_interval(scene_)))) {
+    write_frame();
+    next_frame_ = next_index(t, frame_interval(scene_));
+  }
+  if (options_.checkpoint_interval) {
+    const double ci = *options_.checkpoint_interval;
+    if (final ? last_checkpoint_step_ != step : due(t, next_checkpoint_, ci)) {
+      next_checkpoint_ = next_index(t, ci);
+      write_checkpoint();
+    }
+  }
+}
+
+void Runner::write_row() {
+  const Diagnostics d = sim_.diagnostics();
+  std::vector<double> row{d.time, static_cast<double>(d.step), d.dt, static_cast<double>(d.fluid),
+                          static_cast<double>(d.ghosts), static_cast<double>(d.walls)};
+  for (int l = 0; l <= finest_level(scene_); ++l) {
+    const auto k = static_cast<std::size_t>(l);
+    row.push_back(k < d.per_level.size() ? static_cast<double>(d.per_level[k]) : 0.0);
+  }
+  for (const double v : {d.mass, d.momentum[0], d.momentum[1], d.angular_momentum, d.kinetic, d.potential, d.elastic,
+                         d.total_energy(), d.max_speed, d.max_density_error}) {
+    row.push_back(v);
+  }
+  for (const double v : probes_.measure(sim_.store())) row.push_back(v);
+  series_->write(row);
+  last_row_step_ = d.step;
+  ++rows_;
+}
+
+void Runner::write_frame() {
+  const std::uint64_t index = frame_count_;
+  const io::FrameHeader h = io::write_frame(files_.frame(index), io::RunFiles::frame_group(index), sim_.store(),
+                                            sim_.time(), sim_.step_count(), index, scene_.output.fields);
+  frames_.push_back({"frames/" + io::RunFiles::frame_file_name(index), h});
+  io::write_xdmf(files_.xdmf(), frames_);
+  frame_count_ = index + 1;  // file numbering is dense: frame k is the k-th written; its time is an attribute
+  last_frame_step_ = sim_.step_count();
+  ++frames_written_;
+}
+
+void Runner::write_checkpoint() {
+  io::CheckpointState s;
+  s.time = sim_.time();
+  s.step = sim_.step_count();
+  s.dt = sim_.dt();
+  s.next_id = sim_.store().next_id();
+  s.next_row = next_row_;
+  s.next_frame = next_frame_;
+  s.frame_count = frame_count_;
+  s.next_checkpoint = next_checkpoint_;
+  s.particle_steps = particle_steps_;
+  s.initial_mass = initial_mass_;
+  s.initial_momentum_x = initial_momentum_[0];
+  s.initial_momentum_y = initial_momentum_[1];
+  s.scene = scene_to_json(scene_).dump();
+  io::write_checkpoint(files_.checkpoint(), sim_.store(), s);
+  last_checkpoint_step_ = s.step;
+  ++checkpoints_;
+}
+
+RunSummary Runner::finish() {
+  if (!started_) start();
+  write_due_outputs(true);
+  RunSummary r;
+  r.wall_seconds = now_seconds() - wall_start_;
+  r.steps = steps_run_;
+  r.particle_steps = particle_steps_;
+  r.final = sim_.diagnostics();
+  r.initial_mass = initial_mass_;
+  r.initial_momentum = initial_momentum_;
+  r.mass_drift = initial_mass_ > 0.0 ? (r.final.mass - initial_mass_) / initial_mass_ : 0.0;
+  r.momentum_change = (r.final.momentum - initial_momentum_).norm();
+  r.rows = rows_;
+  r.frames = frames_written_;
+  r.checkpoints = checkpoints_;
+  if (!options_.folder.empty()) {
+    Json j;
+    j["scene"] = scene_.name;
+    j["version"] = SPH_VERSION;
+    j["build_type"] = SPH_BUILD_TYPE;
+    j["threads"] = omp_get_max_threads();
+    j["sweep"] = sim_.sweep_name();
+    j["resumed"] = resumed_;
+    j["time"] = r.final.time;
+    j["step"] = r.final.step;
+    j["steps_this_run"] = r.steps;
+    j["wall_seconds"] = r.wall_seconds;
+    j["particle_steps"] = r.particle_steps;
+    j["particle_steps_per_second"] = r.wall_seconds > 0.0 ? static_cast<double>(r.particle_steps) / r.wall_seconds : 0.0;
+    j["fluid_per_level"] = r.final.per_level;
+    j["mass_drift"] = r.mass_drift;
+    j["momentum_change"] = r.momentum_change;
+    j["rows"] = r.rows;
+    j["frames"] = r.frames;
+    io::write_file_atomic(files_.summary(), j.dump(2) + "\n");
+  }
+  return r;
+}
+
+RunSummary Runner::run(const std::function<void(const Progress&)>& on_step) {
+  start();
+  while (!finished()) {
+    advance();
+    if (on_step) {
+      on_step(Progress{sim_.time(), scene_.time.end, sim_.step_count(), steps_run_, fluid_count(),
+                       now_seconds() - wall_start_});
+    }
+  }
+  return finish();
+}
+
+}  // namespace sph::scene

@@ -1,0 +1,107 @@
+#pragma once
+// Runs a scene to its end time with its outputs: the time series (diagnostics and probes) every
+// output_interval, HDF5 frames with an XDMF index every frame_interval, checkpoints on request, and a
+// run summary. Outputs only read the particles (ghosts are skipped, never removed), and output times never
+// cap the time step, so a run that writes output is bitwise identical to one that does not; a run resumed
+// from a checkpoint continues bitwise identically to the uninterrupted run.
+//
+// Output times: row k is written at the first step whose time reaches k * output_interval (t = 0 included),
+// and a last row at the end; frames likewise with frame_interval.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "core/diagnostics.hpp"
+#include "core/io/output_folder.hpp"
+#include "core/io/xdmf.hpp"
+#include "core/scene/probes.hpp"
+#include "core/scene/scene.hpp"
+#include "core/simulation.hpp"
+
+namespace sph::io {
+class TimeSeriesWriter;
+}
+
+namespace sph::scene {
+
+struct RunOptions {
+  std::filesystem::path folder;                 // output folder; empty: the run writes nothing
+  std::optional<std::filesystem::path> resume;  // continue from this checkpoint
+  std::optional<double> checkpoint_interval;    // simulated seconds between checkpoints (and one at the end)
+};
+
+struct Progress {
+  double time = 0.0;
+  double end = 0.0;
+  std::uint64_t step = 0;          // the simulation's step counter
+  std::uint64_t steps_run = 0;     // steps taken by this invocation
+  std::size_t fluid = 0;           // fluid particles
+  double wall_seconds = 0.0;       // since run() started
+};
+
+struct RunSummary {
+  double wall_seconds = 0.0;
+  std::uint64_t steps = 0;           // taken by this invocation
+  std::uint64_t particle_steps = 0;  // sum over those steps of the fluid particle count
+  Diagnostics final;
+  double initial_mass = 0.0;
+  Vec<2> initial_momentum = Vec<2>::Zero();
+  double mass_drift = 0.0;      // (M - M0) / M0
+  double momentum_change = 0.0; // |P - P0| (kg m/s); walls and gravity change it physically
+  std::uint64_t rows = 0, frames = 0, checkpoints = 0;
+};
+
+class Runner {
+ public:
+  /// Builds the simulation (or loads the checkpoint). Does not create the folder: call start().
+  Runner(Scene scene, RunOptions options);
+  ~Runner();
+  Runner(const Runner&) = delete;
+  Runner& operator=(const Runner&) = delete;
+
+  const Scene& scene() const { return scene_; }
+  Simulation& simulation() { return sim_; }
+  const Simulation& simulation() const { return sim_; }
+  double end_time() const { return scene_.time.end; }
+  bool finished() const;
+
+  /// Creates the output folder, writes the resolved scene and the first outputs (not when resuming).
+  void start();
+  /// One step, the stages, and the outputs that fall due. Throws std::runtime_error if the run diverges.
+  void advance();
+  /// The last outputs, a checkpoint if requested, run.json; returns the summary.
+  RunSummary finish();
+  /// start(), advance() until the end (calling on_step after each step), finish().
+  RunSummary run(const std::function<void(const Progress&)>& on_step = {});
+
+  /// The time-series column names.
+  std::vector<std::string> columns() const;
+
+ private:
+  void write_due_outputs(bool final);
+  void write_row();
+  void write_frame();
+  void write_checkpoint();
+  std::size_t fluid_count() const;
+
+  Scene scene_;
+  RunOptions options_;
+  io::RunFiles files_;
+  Simulation sim_;
+  Probes probes_;
+  std::unique_ptr<io::TimeSeriesWriter> series_;
+  std::vector<io::XdmfEntry> frames_;
+  std::uint64_t next_row_ = 0, next_frame_ = 0, frame_count_ = 0, next_checkpoint_ = 1;
+  std::uint64_t last_row_step_ = UINT64_MAX, last_frame_step_ = UINT64_MAX, last_checkpoint_step_ = UINT64_MAX;
+  std::uint64_t particle_steps_ = 0, steps_run_ = 0, rows_ = 0, frames_written_ = 0, checkpoints_ = 0;
+  double initial_mass_ = 0.0;
+  Vec<2> initial_momentum_ = Vec<2>::Zero();
+  bool resumed_ = false;
+  bool started_ = false;
+  double wall_start_ = 0.0;
+};
+
+}  // namespace sph::scene

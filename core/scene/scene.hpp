@@ -1,0 +1,177 @@
+#pragma once
+// The scene model: a plain description of one run (geometry, fluid, material, effects, time, probes,
+// output), exactly what a scene file (JSON, docs/SCENES.md) says, with the file's defaults filled in.
+// Parsing (scene_parser.hpp) fills it and validates it; building (scene_builder.hpp) turns it into a
+// ready Simulation. An effect absent from the scene is std::nullopt here and is not computed.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/types.hpp"
+
+namespace sph::scene {
+
+/// Axis-aligned rectangle [lo, hi] (m).
+struct Rect {
+  Vec<2> lo = Vec<2>::Zero();
+  Vec<2> hi = Vec<2>::Zero();
+  bool operator==(const Rect&) const = default;
+};
+
+struct Container {
+  Rect box;
+  bool open_top = true;
+  bool operator==(const Container&) const = default;
+};
+
+enum class Shape { rectangle, circle };
+
+/// A block of fluid filled with a square lattice (particles at cell centres).
+struct FluidRegion {
+  Shape shape = Shape::rectangle;
+  Rect rect;                           // rectangle
+  Vec<2> centre = Vec<2>::Zero();      // circle
+  double radius = 0.0;                 // circle (m)
+  double spacing = 0.0;                // d^0: the level-0 spacing (m); the lattice is d^0 / 2^level
+  int level = 0;                       // initial refinement level of the region's particles
+  Vec<2> velocity = Vec<2>::Zero();    // initial velocity (m/s)
+  bool hydrostatic = false;            // hydrostatic initial density (needs gravity along -y)
+  std::optional<double> surface;       // y of the free surface for the hydrostatic start (default: top)
+  bool operator==(const FluidRegion&) const = default;
+
+  double lattice_spacing() const;
+};
+
+/// rho0 and the sound speed: c0 given directly, or c0 = mach_factor * v_ref with v_ref a speed or the
+/// free-fall speed sqrt(2 g H) from a reference height H.
+struct Material {
+  double rho0 = 1000.0;
+  double gamma = 7.0;
+  std::optional<double> c0;
+  std::optional<double> mach_factor;
+  std::optional<double> reference_speed;
+  std::optional<double> reference_height;
+  bool operator==(const Material&) const = default;
+};
+
+struct ArtificialViscosity {
+  double alpha = 0.02;
+  double beta = 0.0;
+  bool operator==(const ArtificialViscosity&) const = default;
+};
+
+/// Fixed wall particles with the Lennard-Jones repulsion, eq. (10). D given directly (strength) or as
+/// 5 g H from a reference height.
+struct LennardJonesWall {
+  std::optional<double> strength;
+  std::optional<double> reference_height;
+  double r0_factor = 0.5;
+  std::optional<double> spacing;  // default: half the finest fluid spacing the scene can reach
+  bool operator==(const LennardJonesWall&) const = default;
+};
+
+enum class Slip { free_slip, no_slip };
+enum class Criterion { velocity, zone, few_neighbours };
+enum class Pattern { aap, rsp };
+
+struct Refinement {
+  Criterion criterion = Criterion::velocity;
+  double v_threshold = 10.0;
+  Rect zone;
+  int min_neighbours = 8;
+  Pattern pattern = Pattern::aap;
+  double rsp_k = 1.0;
+  int check_interval = 100;
+  int max_level = 1;
+  bool operator==(const Refinement&) const = default;
+};
+
+/// Refinement once at set-up: every fluid particle (no box) or those inside the box.
+struct StaticRefinement {
+  std::optional<Rect> box;
+  Pattern pattern = Pattern::aap;
+  double rsp_k = 1.0;
+  bool operator==(const StaticRefinement&) const = default;
+};
+
+struct Effects {
+  std::optional<Vec<2>> gravity;
+  std::optional<ArtificialViscosity> artificial_viscosity;
+  std::optional<LennardJonesWall> lennard_jones_wall;
+  std::optional<Slip> ghost_walls;
+  std::optional<Refinement> refinement;
+  std::optional<StaticRefinement> static_refinement;
+  bool operator==(const Effects&) const = default;
+};
+
+struct Time {
+  double end = 0.0;
+  double cfl = 0.2;
+  std::optional<double> output_interval;  // default end / 100
+  double dt_max = 1.0;
+  bool operator==(const Time&) const = default;
+
+  double interval() const { return output_interval.value_or(end / 100.0); }
+};
+
+enum class ProbeKind { water_height, surge_front, surface_elevation, pressure };
+
+/// A measurement written to the time series every output interval (docs/SCENES.md, "probes").
+struct Probe {
+  ProbeKind kind = ProbeKind::water_height;
+  std::string name;
+  double x = 0.0;                       // water_height, surface_elevation: the column sampled
+  std::optional<double> band;           // half-width of the sampled column (default: largest d^0)
+  std::optional<double> origin;         // surge_front: where Z is measured from (default container lo.x)
+  double datum = 0.0;                   // surface_elevation: elevation measured from this y
+  Vec<2> position = Vec<2>::Zero();     // pressure
+  bool operator==(const Probe&) const = default;
+};
+
+struct Output {
+  std::string folder;                   // default "out/<name>"
+  bool frames = true;
+  std::optional<double> frame_interval;  // default time.output_interval
+  std::vector<std::string> fields;      // empty: every field
+  bool operator==(const Output&) const = default;
+};
+
+struct Scene {
+  std::string name = "scene";
+  std::string description;
+  Container container;
+  std::vector<Rect> obstacles;
+  std::vector<FluidRegion> fluid;
+  double h_factor = 1.2;
+  Material material;
+  Effects effects;
+  Time time;
+  std::vector<Probe> probes;
+  Output output;
+  bool operator==(const Scene&) const = default;
+};
+
+// Quantities derived from a scene (the rules are in docs/SCENES.md).
+
+/// |g| along -y used for hydrostatic starts and reference heights (0 without gravity).
+double gravity_magnitude(const Scene& s);
+/// The sound speed c0 the scene resolves to.
+double sound_speed(const Scene& s);
+/// The deepest level any particle can reach (initial level, static and dynamic refinement).
+int finest_level(const Scene& s);
+/// The finest fluid spacing the scene can reach: min over regions of d^0 / 2^finest_level.
+double finest_spacing(const Scene& s);
+/// The Lennard-Jones wall-particle spacing (given, or half the finest spacing).
+double wall_spacing(const Scene& s);
+/// The Lennard-Jones strength D (given, or 5 g H_ref).
+double lennard_jones_strength(const Scene& s);
+/// The largest level-0 spacing of the fluid regions (default probe band).
+double coarsest_spacing(const Scene& s);
+
+const char* to_string(Shape v);
+const char* to_string(Slip v);
+const char* to_string(Criterion v);
+const char* to_string(Pattern v);
+const char* to_string(ProbeKind v);
+
+}  // namespace sph::scene
