@@ -1,6 +1,9 @@
 #include "core/scene/probes.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 #include <limits>
 
 #include "core/kernel.hpp"
@@ -9,28 +12,43 @@ namespace sph::scene {
 
 namespace {
 
-/// max(y_i + d_i/2) over the fluid column |x_i - x| <= band, or -infinity when it is dry.
-double column_top(const ParticleStore<2>& store, double x, double band) {
-  double top = -std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < store.size(); ++i) {
-    if (store.kind[i] != Kind::fluid || std::abs(store.x[i][0] - x) > band) continue;
-    top = std::max(top, store.x[i][1] + 0.5 * store.d[i]);
+/// The end of the run of values that starts at the smallest one and has no gap wider than `gap`: the edge of
+/// the body of water, so that isolated splash particles beyond a gap do not move the probes.
+double contiguous_top(std::vector<std::pair<double, double>>& v, double gap) {
+  if (v.empty()) return -std::numeric_limits<double>::infinity();
+  std::sort(v.begin(), v.end());
+  double top = v.front().first + v.front().second;
+  for (std::size_t k = 1; k < v.size(); ++k) {
+    if (v[k].first - v[k - 1].first > gap) break;
+    top = std::max(top, v[k].first + v[k].second);
   }
   return top;
 }
 
+/// The top y + d/2 of the water column |x_i - x| <= band connected to the bottom of the column (gaps of
+/// more than `gap` end it), or -infinity when the column is dry.
+double column_top(const ParticleStore<2>& store, double x, double band, double gap) {
+  std::vector<std::pair<double, double>> ys;
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    if (store.kind[i] != Kind::fluid || std::abs(store.x[i][0] - x) > band) continue;
+    ys.emplace_back(store.x[i][1], 0.5 * store.d[i]);
+  }
+  return contiguous_top(ys, gap);
+}
+
 }  // namespace
 
-double water_height(const ParticleStore<2>& store, double x, double band, double floor) {
-  const double top = column_top(store, x, band);
+double water_height(const ParticleStore<2>& store, double x, double band, double floor, double gap) {
+  const double top = column_top(store, x, band, gap);
   return std::isfinite(top) ? top - floor : 0.0;
 }
 
-double surge_front(const ParticleStore<2>& store, double origin) {
-  double front = -std::numeric_limits<double>::infinity();
+double surge_front(const ParticleStore<2>& store, double origin, double gap) {
+  std::vector<std::pair<double, double>> xs;
   for (std::size_t i = 0; i < store.size(); ++i) {
-    if (store.kind[i] == Kind::fluid) front = std::max(front, store.x[i][0] + 0.5 * store.d[i]);
+    if (store.kind[i] == Kind::fluid) xs.emplace_back(store.x[i][0], 0.5 * store.d[i]);
   }
+  const double front = contiguous_top(xs, gap);
   return std::isfinite(front) ? front - origin : 0.0;
 }
 
@@ -49,6 +67,7 @@ double point_pressure(const ParticleStore<2>& store, const Vec<2>& point) {
 
 Probes::Probes(const Scene& scene) {
   const double band = coarsest_spacing(scene);
+  gap_ = 2.0 * band;
   for (const Probe& p : scene.probes) {
     Resolved r{p.kind, p.x, p.band.value_or(band), 0.0, p.position};
     switch (p.kind) {
@@ -67,13 +86,13 @@ std::vector<double> Probes::measure(const ParticleStore<2>& store) const {
   out.reserve(probes_.size());
   for (const Resolved& p : probes_) {
     switch (p.kind) {
-      case ProbeKind::water_height: out.push_back(water_height(store, p.x, p.band, p.reference)); break;
+      case ProbeKind::water_height: out.push_back(water_height(store, p.x, p.band, p.reference, gap_)); break;
       case ProbeKind::surface_elevation: {
-        const double top = column_top(store, p.x, p.band);
+        const double top = column_top(store, p.x, p.band, gap_);
         out.push_back(std::isfinite(top) ? top - p.reference : std::numeric_limits<double>::quiet_NaN());
         break;
       }
-      case ProbeKind::surge_front: out.push_back(surge_front(store, p.reference)); break;
+      case ProbeKind::surge_front: out.push_back(surge_front(store, p.reference, gap_)); break;
       case ProbeKind::pressure: out.push_back(point_pressure(store, p.position)); break;
     }
   }

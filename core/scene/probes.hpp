@@ -4,6 +4,9 @@
 //                      (the paper's H(t) at a wall; H = H0 at t = 0 for a lattice column)
 //   surface_elevation  max(y_i + d_i/2) - datum over the same column (NaN when the column is dry)
 //   surge_front        Z = max(x_i + d_i/2) - origin over every fluid particle (the paper's Z(t))
+// Each maximum is taken over the body of water only: the values are sorted from the bottom (or from the
+// back wall) and the walk stops at the first gap wider than two coarse spacings, so a few isolated splash
+// particles ahead of the front or above the surface do not move the probes.
 //   pressure           Shepard-normalised SPH interpolation of p at a point over fluid and ghost particles,
 //                      sum_j V_j p_j W(r, h_j) / sum_j V_j W(r, h_j), V_j = m_j / rho_j (0 when no particle
 //                      reaches the point)
@@ -16,8 +19,8 @@
 
 namespace sph::scene {
 
-double water_height(const ParticleStore<2>& store, double x, double band, double floor);
-double surge_front(const ParticleStore<2>& store, double origin);
+double water_height(const ParticleStore<2>& store, double x, double band, double floor, double gap);
+double surge_front(const ParticleStore<2>& store, double origin, double gap);
 double point_pressure(const ParticleStore<2>& store, const Vec<2>& point);
 
 class Probes {
@@ -34,6 +37,7 @@ class Probes {
     Vec<2> position;
   };
   std::vector<Resolved> probes_;
+  double gap_ = 0.0;  // two coarse spacings: a wider gap separates splash from the body of water
   std::vector<std::string> names_;
 };
 
