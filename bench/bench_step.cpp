@@ -1,0 +1,73 @@
+// One whole step (ghosts + grid + sweep + integrate) of a dam-break block at N = 1e4, 1e5, 1e6 fluid
+// particles, 1 and 2 threads, in fluid particle-steps per second; and the cost of each effect: the pair
+// sweep alone with and without viscosity and with and without the Lennard-Jones wall, and a step with and
+// without ghost walls. Args: {N, threads}.
+#include <benchmark/benchmark.h>
+#include <omp.h>
+
+#include <cmath>
+
+#include "core/allocator_tuning.hpp"
+#include "core/case_builder.hpp"
+
+namespace {
+
+using namespace sph;
+
+const bool tuned = (tune_allocator(), true);
+
+DamBreakSpec block(std::size_t n) {
+  DamBreakSpec spec;
+  spec.spacing = spec.column_width / std::round(std::sqrt(static_cast<double>(n)));
+  return spec;
+}
+
+void BM_Step_DamBreak(benchmark::State& state, bool ghosts) {
+  omp_set_num_threads(static_cast<int>(state.range(1)));
+  DamBreakSpec spec = block(static_cast<std::size_t>(state.range(0)));
+  spec.ghosts = ghosts;
+  Simulation sim = make_dam_break(spec);
+  const std::size_t fluid = sim.diagnostics().fluid;
+  for (auto _ : state) sim.step();
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * fluid));
+  state.counters["pairs_per_particle"] = static_cast<double>(sim.last_limits().pairs) / static_cast<double>(fluid);
+}
+
+void BM_Step_WithGhosts(benchmark::State& state) { BM_Step_DamBreak(state, true); }
+void BM_Step_WithoutGhosts(benchmark::State& state) { BM_Step_DamBreak(state, false); }
+
+// The sweep alone on a prepared store, for each effect set.
+void BM_Sweep_Effects(benchmark::State& state, bool viscosity, bool lennard_jones) {
+  omp_set_num_threads(static_cast<int>(state.range(1)));
+  DamBreakSpec spec = block(static_cast<std::size_t>(state.range(0)));
+  spec.viscosity = viscosity;
+  spec.lennard_jones = lennard_jones;
+  Simulation sim = make_dam_break(spec);
+  for (int k = 0; k < 20; ++k) sim.step();  // a moving state, so that viscosity does work
+  const auto sweep = make_sweep(sim.settings());
+  const std::size_t fluid = sim.diagnostics().fluid;
+  for (auto _ : state) benchmark::DoNotOptimize(sweep->run(sim.store().view(), sim.grid()));
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * fluid));
+}
+
+void BM_Sweep_PressureOnly(benchmark::State& s) { BM_Sweep_Effects(s, false, false); }
+void BM_Sweep_Viscosity(benchmark::State& s) { BM_Sweep_Effects(s, true, false); }
+void BM_Sweep_LennardJones(benchmark::State& s) { BM_Sweep_Effects(s, false, true); }
+void BM_Sweep_ViscosityAndLennardJones(benchmark::State& s) { BM_Sweep_Effects(s, true, true); }
+
+void sizes(benchmark::internal::Benchmark* b) {
+  for (int64_t n : {10000, 100000, 1000000})
+    for (int64_t t : {1, 2}) b->Args({n, t});
+}
+
+BENCHMARK(BM_Step_WithGhosts)->Apply(sizes)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Step_WithoutGhosts)->Args({100000, 1})->Args({100000, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Sweep_PressureOnly)->Args({100000, 1})->Args({100000, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Sweep_Viscosity)->Args({100000, 1})->Args({100000, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Sweep_LennardJones)->Args({100000, 1})->Args({100000, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Sweep_ViscosityAndLennardJones)->Args({100000, 1})->Args({100000, 2})
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();
