@@ -92,7 +92,7 @@ int run_command(const RunArguments& args) {
     scene::Runner runner(s, options);
     if (args.force && args.resume.empty()) files.clear_run();
     if (!args.quiet) {
-      std::printf("sphrefine %s: %s, %zu fluid particles, %d threads, sweep %s -> %s\n", SPH_VERSION, s.name.c_str(),
+      std::printf("sphrefine %s: %s, %zu fluid particles, threads %d, sweep %s -> %s\n", SPH_VERSION, s.name.c_str(),
                   runner.simulation().diagnostics().fluid, omp_get_max_threads(), runner.simulation().sweep_name(),
                   folder.string().c_str());
       if (options.resume) {

@@ -143,7 +143,8 @@ void Runner::advance() {
                              " s; try a smaller time.cfl, a larger sound speed or more viscosity");
   }
   ++steps_run_;
-  particle_steps_ += fluid_count();
+  last_fluid_ = fluid_count();
+  particle_steps_ += last_fluid_;
   write_due_outputs(false);
 }
 
@@ -262,7 +263,7 @@ RunSummary Runner::run(const std::function<void(const Progress&)>& on_step) {
   while (!finished()) {
     advance();
     if (on_step) {
-      on_step(Progress{sim_.time(), scene_.time.end, sim_.step_count(), steps_run_, fluid_count(),
+      on_step(Progress{sim_.time(), scene_.time.end, sim_.step_count(), steps_run_, last_fluid_,
                        now_seconds() - wall_start_});
     }
   }

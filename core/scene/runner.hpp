@@ -97,6 +97,7 @@ class Runner {
   std::uint64_t next_row_ = 0, next_frame_ = 0, frame_count_ = 0, next_checkpoint_ = 1;
   std::uint64_t last_row_step_ = UINT64_MAX, last_frame_step_ = UINT64_MAX, last_checkpoint_step_ = UINT64_MAX;
   std::uint64_t particle_steps_ = 0, steps_run_ = 0, rows_ = 0, frames_written_ = 0, checkpoints_ = 0;
+  std::size_t last_fluid_ = 0;  // fluid particles after the last step
   double initial_mass_ = 0.0;
   Vec<2> initial_momentum_ = Vec<2>::Zero();
   bool resumed_ = false;

@@ -801,10 +801,12 @@ void validate_scene(const Scene& s) {
     const double r0 = w.r0_factor * d;
     const double ws = wall_spacing(s);
     if (ws > r0 * (1.0 + 1e-9)) {
-      fail(w.spacing ? p + ".spacing" : std::string("effects.refinement.max_level"),
+      // With an explicit spacing, a coarser finest level (max_level) or a finer wall spacing fixes it; with the
+      // default spacing (d_min / 2) only r0_factor can be at fault.
+      fail(w.spacing ? p + ".spacing" : p + ".r0_factor",
            "the walls cannot resolve level " + std::to_string(finest_level(s)) + ": wall-particle spacing " + num(ws) +
                " m exceeds the repulsion range r0 = r0_factor * d = " + num(r0) + " m of its particles (d = " + num(d) +
-               " m); lower max_level or the wall spacing");
+               (w.spacing ? " m); lower the refinement level or the wall spacing" : " m); raise r0_factor to 0.5 or more"));
     }
     double extent = 2.0 * (s.container.box.hi - s.container.box.lo).sum();
     for (const auto& o : s.obstacles) extent += 2.0 * (o.hi - o.lo).sum();
@@ -815,6 +817,7 @@ void validate_scene(const Scene& s) {
   positive(t.end, "time.end");
   if (!(t.cfl > 0.0 && t.cfl <= 1.0)) fail("time.cfl", "must be in (0, 1] (got " + num(t.cfl) + ")");
   positive(t.dt_max, "time.dt_max");
+  if (t.end / t.dt_max > 1e9) fail("time.dt_max", "would take more than 1e9 steps to reach time.end");
   if (t.output_interval) {
     positive(*t.output_interval, "time.output_interval");
     if (t.end / *t.output_interval > 1e6) fail("time.output_interval", "would write more than a million outputs");

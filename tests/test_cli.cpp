@@ -1,0 +1,260 @@
+// The sphrefine program, run as a user would: each kind of bad input ends with exit code 2, one
+// "scene error: <key.path>: <rule>" line on stderr and nothing created; a good run writes its folder, prints
+// a summary, and a second run into the same folder is refused (exit 3) unless --force.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <regex>
+#include <string>
+
+#include "core/io/hdf5_frames.hpp"
+
+namespace {
+
+using namespace sph;
+
+namespace fs = std::filesystem;
+
+/// The program next to this test in the build tree (build/tests/ -> build/app/sphrefine), unless CMake names it.
+fs::path program() {
+#ifdef SPHREFINE_EXE
+  return SPHREFINE_EXE;
+#else
+  return fs::read_symlink("/proc/self/exe").parent_path().parent_path() / "app" / "sphrefine";
+#endif
+}
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(fs::exists(program())) << program() << " not built";
+    dir_ = fs::temp_directory_path() /
+           ("sph_test_cli_" + std::to_string(::getpid()) + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ / "work");
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+
+  /// Runs the program with `args` (shell words) in the work folder; stdout and stderr go to files outside it.
+  Result run(const std::string& args) {
+    const std::string cmd = "cd '" + (dir_ / "work").string() + "' && OMP_NUM_THREADS=1 '" + program().string() + "' " +
+                            args + " > '" + (dir_ / "stdout").string() + "' 2> '" + (dir_ / "stderr").string() + "'";
+    const int status = std::system(cmd.c_str());
+    Result r;
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(dir_ / "stdout");
+    r.err = slurp(dir_ / "stderr");
+    return r;
+  }
+
+  void write_scene(const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / "work" / name) << text;
+  }
+
+  /// The names in the work folder (to check that nothing was created).
+  std::vector<std::string> work_files() const {
+    std::vector<std::string> names;
+    for (const auto& e : fs::recursive_directory_iterator(dir_ / "work")) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+
+  fs::path dir_;
+};
+
+const char* kTiny = R"({
+  "name": "tiny",
+  "container": { "lo": [0, 0], "hi": [4, 3] },
+  "obstacles": [ { "lo": [3, 0], "hi": [3.5, 0.5] } ],
+  "fluid": [ { "shape": "rectangle", "lo": [0, 0], "hi": [1, 2], "spacing": 0.1, "hydrostatic": true } ],
+  "material": { "rho0": 1000, "mach_factor": 10, "reference_height": 2 },
+  "effects": {
+    "gravity": [0, -9.81],
+    "artificial_viscosity": { "alpha": 0.02 },
+    "lennard_jones_wall": { "reference_height": 2 },
+    "ghost_walls": "free-slip",
+    "refinement": { "criterion": "velocity", "v_threshold": 0.4, "check_interval": 20, "max_level": 1 }
+  },
+  "time": { "end": 0.02, "output_interval": 0.005 },
+  "probes": [ { "type": "water_height", "name": "H", "x": 0 }, { "type": "surge_front", "name": "Z" } ]
+})";
+
+/// kTiny with one textual replacement.
+std::string tiny_with(const std::string& from, const std::string& to) {
+  std::string s = kTiny;
+  const std::size_t at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) s.replace(at, from.size(), to);
+  return s;
+}
+
+TEST_F(Cli, InfoPrintsVersionsAndThreads) {
+  const Result r = run("info");
+  EXPECT_EQ(r.code, 0) << r.err;
+  for (const char* word : {"sphrefine 0.", "OpenMP", "max threads 1", "Eigen", "HDF5", "nlohmann", "CLI11"}) {
+    EXPECT_NE(r.out.find(word), std::string::npos) << word << "\n" << r.out;
+  }
+}
+
+TEST_F(Cli, ValidateAGoodSceneWritesNothing) {
+  write_scene("tiny.json", kTiny);
+  const Result r = run("validate tiny.json");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("scene OK: tiny"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("fluid particles    200"), std::string::npos) << r.out;
+  EXPECT_EQ(work_files(), std::vector<std::string>{"tiny.json"});
+}
+
+TEST_F(Cli, EveryKindOfBadInputExitsTwoWithOneMessageAndCreatesNothing) {
+  struct Case {
+    std::string scene;    // the scene text
+    std::string extra;    // extra arguments
+    std::string message;  // the expected first line of stderr (prefix)
+  };
+  const Case cases[] = {
+      {tiny_with("\"spacing\"", "\"spacng\""), "", "scene error: fluid[0].spacng: unknown key (did you mean 'spacing'?)"},
+      {tiny_with("\"end\": 0.02", "\"end\": \"soon\""), "", "scene error: time.end: must be a number (got a string)"},
+      {tiny_with("\"end\": 0.02, ", ""), "", "scene error: time.end: missing required key"},
+      {tiny_with("\"spacing\": 0.1", "\"spacing\": 0"), "", "scene error: fluid[0].spacing: must be positive (got 0)"},
+      {tiny_with("\"spacing\": 0.1", "\"spacing\": -0.1"), "", "scene error: fluid[0].spacing: must be positive (got -0.1)"},
+      {tiny_with("\"rho0\": 1000", "\"rho0\": -1"), "", "scene error: material.rho0: must be positive (got -1)"},
+      {tiny_with("\"end\": 0.02", "\"end\": -1"), "", "scene error: time.end: must be positive (got -1)"},
+      {tiny_with("\"hi\": [1, 2]", "\"hi\": [5, 2]"), "", "scene error: fluid[0]: the rectangle reaches outside the container"},
+      {tiny_with("\"hi\": [1, 2]", "\"hi\": [3.2, 2]"), "",
+       "scene error: fluid[0]: overlaps obstacles[0] (fluid must start outside every obstacle)"},
+      {tiny_with("\"lennard_jones_wall\": { \"reference_height\": 2 }",
+                 "\"lennard_jones_wall\": { \"reference_height\": 2, \"spacing\": 0.1 }"),
+       "",
+       "scene error: effects.lennard_jones_wall.spacing: the walls cannot resolve level 1"},
+      {tiny_with("\"max_level\": 1", "\"max_level\": 12"), "",
+       "scene error: effects.refinement.max_level: must be between 1 and 8 (got 12)"},
+      {tiny_with("\"ghost_walls\": \"free-slip\"", "\"ghost_walls\": \"sticky\""), "",
+       "scene error: effects.ghost_walls: must be one of: free-slip, no-slip (got 'sticky')"},
+      {tiny_with("\"end\": 0.02,", "\"end\": 0.02, \"end\": 1,"), "", "scene error: time.end: duplicate key"},
+      {tiny_with("\"name\": \"tiny\",", "\"name\": \"tiny\""), "", "scene error: scene.json: malformed JSON: "},
+      {"", "", "scene error: scene.json: malformed JSON: "},
+      {kTiny, "--set time.ned=1", "scene error: time.ned: unknown key (did you mean 'end'?)"},
+      {kTiny, "--set time.end", "scene error: --set: expected key.path=value (got 'time.end')"},
+      {kTiny, "--set fluid[3].spacing=1", "scene error: --set fluid[3].spacing: index 3 is out of range"},
+  };
+  for (const Case& c : cases) {
+    write_scene("scene.json", c.scene);
+    for (const char* command : {"run scene.json -o out -q", "validate scene.json"}) {
+      const Result r = run(std::string(command) + " " + c.extra);
+      SCOPED_TRACE(std::string(command) + " " + c.extra + " | " + c.message);
+      EXPECT_EQ(r.code, 2);
+      EXPECT_EQ(r.err.rfind(c.message, 0), 0u) << r.err;
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+      EXPECT_EQ(work_files(), std::vector<std::string>{"scene.json"});
+    }
+  }
+  const Result missing = run("run nowhere.json");
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_EQ(missing.err, "scene error: nowhere.json: no such scene file\n");
+}
+
+TEST_F(Cli, CommandLineMistakesExitTwo) {
+  write_scene("tiny.json", kTiny);
+  EXPECT_EQ(run("").code, 2);
+  EXPECT_EQ(run("fly tiny.json").code, 2);
+  EXPECT_EQ(run("run tiny.json --bogus").code, 2);
+  EXPECT_EQ(run("run tiny.json --threads 0").code, 2);
+  EXPECT_EQ(run("run").code, 2);
+  EXPECT_EQ(run("run tiny.json --resume nowhere.h5").code, 2);
+  EXPECT_EQ(work_files(), std::vector<std::string>{"tiny.json"});
+  EXPECT_EQ(run("--help").code, 0);
+}
+
+TEST_F(Cli, RunWritesItsFolderAndRefusesToOverwriteWithoutForce) {
+  write_scene("tiny.json", kTiny);
+  const Result first = run("run tiny.json --threads 1");
+  ASSERT_EQ(first.code, 0) << first.err;
+  for (const char* word : {"reached t = 0.02 s", "particle-steps/s", "fluid per level    L0 ", "mass drift         +0.000e+00",
+                           "momentum change", "output             out/tiny"}) {
+    EXPECT_NE(first.out.find(word), std::string::npos) << word << "\n" << first.out;
+  }
+  // Not a terminal: plain progress lines, never a carriage return.
+  EXPECT_EQ(first.out.find('\r'), std::string::npos);
+  EXPECT_NE(first.out.find("t = 0.02 / 0.02 s (100%)"), std::string::npos) << first.out;
+  const fs::path out = dir_ / "work" / "out" / "tiny";
+  for (const char* f : {"scene.json", "series.csv", "frames.xdmf", "run.json", "frames/frame_000000.h5"}) {
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  }
+  const auto before = fs::last_write_time(out / "series.csv");
+
+  const Result second = run("run tiny.json -q");
+  EXPECT_EQ(second.code, 3);
+  EXPECT_NE(second.err.find("already holds a run; use --force"), std::string::npos) << second.err;
+  EXPECT_EQ(fs::last_write_time(out / "series.csv"), before);
+
+  std::ofstream(out / "notes.txt") << "mine";
+  const Result forced = run("run tiny.json -q --force --set time.end=0.01");
+  EXPECT_EQ(forced.code, 0) << forced.err;
+  EXPECT_TRUE(fs::exists(out / "notes.txt")) << "--force removes only the run's own files";
+  EXPECT_NE(slurp(out / "scene.json").find("\"end\": 0.01"), std::string::npos);
+}
+
+TEST_F(Cli, CheckpointAndResumeThroughTheProgram) {
+  write_scene("tiny.json", kTiny);
+  ASSERT_EQ(run("run tiny.json -q -o a --checkpoint-every 0.01").code, 0);
+  ASSERT_TRUE(fs::exists(dir_ / "work" / "a" / "checkpoint.h5"));
+  const Result resumed = run("run tiny.json -o a --resume a/checkpoint.h5 --set time.end=0.03");
+  EXPECT_EQ(resumed.code, 0) << resumed.err;
+  EXPECT_NE(resumed.out.find("resuming from a/checkpoint.h5 at t = 0.02"), std::string::npos) << resumed.out;
+  EXPECT_NE(resumed.out.find("reached t = 0.03 s"), std::string::npos) << resumed.out;
+  // A checkpoint from a different scene is refused.
+  const Result other = run("run tiny.json -o a --resume a/checkpoint.h5 --set h_factor=1.5");
+  EXPECT_EQ(other.code, 2);
+  EXPECT_EQ(other.err.rfind("scene error: --resume: the checkpoint was written by a different scene", 0), 0u) << other.err;
+}
+
+TEST_F(Cli, AKilledRunLeavesEveryListedFrameReadable) {
+  // Frames every millisecond of simulated time; the run is killed (SIGKILL) part-way.
+  write_scene("tiny.json", tiny_with("\"end\": 0.02, \"output_interval\": 0.005",
+                                     "\"end\": 5, \"output_interval\": 0.001"));
+  const Result r = run("run tiny.json -q -o k & pid=$!; sleep 0.7; kill -9 $pid; wait $pid");
+  EXPECT_EQ(r.code, 128 + 9) << "the run ended before it was killed";
+  const fs::path out = dir_ / "work" / "k";
+  const std::string xml = slurp(out / "frames.xdmf");
+  const std::regex listed(R"re(frames/(frame_\d{6})\.h5:/\1/position)re");
+  int frames = 0;
+  for (auto it = std::sregex_iterator(xml.begin(), xml.end(), listed); it != std::sregex_iterator(); ++it, ++frames) {
+    const fs::path file = out / "frames" / ((*it)[1].str() + ".h5");
+    const io::FrameHeader h = io::read_frame_header(file, (*it)[1].str());
+    EXPECT_EQ(io::read_frame_field(file, h.group, "position").size(), 2 * h.particles);
+  }
+  EXPECT_GT(frames, 2);
+  // Every frame file under its final name is complete (a frame being written is only ever a .tmp).
+  for (const auto& e : fs::directory_iterator(out / "frames")) {
+    if (e.path().extension() != ".h5") continue;
+    EXPECT_NO_THROW((void)io::read_frame_header(e.path(), e.path().stem().string())) << e.path();
+  }
+  // The time series holds only whole lines.
+  const std::string csv = slurp(out / "series.csv");
+  ASSERT_FALSE(csv.empty());
+  EXPECT_EQ(csv.back(), '\n');
+  EXPECT_FALSE(fs::exists(out / "run.json")) << "killed runs have no summary";
+}
+
+}  // namespace

@@ -1,0 +1,222 @@
+// HDF5 frames, the XDMF index and checkpoints: every field read back as written (ghosts left out), the
+// XDMF's dataset paths and shapes match the HDF5 files, checkpoints restore the store exactly, and writes
+// leave no temporary file behind.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <filesystem>
+#include <regex>
+#include <string>
+#include <unistd.h>
+
+#include "core/case_builder.hpp"
+#include "core/io/atomic_file.hpp"
+#include "core/io/hdf5_frames.hpp"
+#include "core/io/output_folder.hpp"
+#include "core/io/xdmf.hpp"
+#include "core/scene/scene_parser.hpp"
+
+namespace {
+
+using namespace sph;
+namespace fs = std::filesystem;
+
+/// These tests check set-up and I/O, not threading (the determinism tests run 1 and N threads): one thread
+/// keeps them fast when the machine is shared.
+class OneThread : public ::testing::Environment {
+ public:
+  void SetUp() override { omp_set_num_threads(1); }
+};
+[[maybe_unused]] ::testing::Environment* const kOneThread = ::testing::AddGlobalTestEnvironment(new OneThread);
+
+/// A fresh empty folder under the system temp directory, removed at the end of the test.
+class TempFolder {
+ public:
+  TempFolder() {
+    path_ = fs::temp_directory_path() / ("sph_test_io_" + std::to_string(::getpid()) + "_" +
+                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempFolder() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+/// A dam break a few steps in: fluid, wall and ghost particles, several levels of nothing special.
+Simulation small_dam() {
+  DamBreakSpec spec;
+  spec.column_width = 5.0;
+  spec.column_height = 5.0;
+  spec.tank_width = 10.0;
+  spec.tank_height = 10.0;
+  spec.spacing = 0.5;
+  Simulation sim = make_dam_break(spec);
+  for (int k = 0; k < 5; ++k) sim.step();
+  return sim;
+}
+
+std::vector<std::size_t> non_ghosts(const ParticleStore<2>& s) {
+  std::vector<std::size_t> keep;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] != Kind::ghost) keep.push_back(i);
+  }
+  return keep;
+}
+
+/// A field as doubles, in the order HDF5 stores it.
+template <class T>
+std::vector<double> as_doubles(const Field<T>& f, const std::vector<std::size_t>& keep) {
+  std::vector<double> out;
+  for (std::size_t i : keep) {
+    if constexpr (std::is_same_v<T, Vec<2>>) {
+      out.push_back(f[i][0]);
+      out.push_back(f[i][1]);
+    } else {
+      out.push_back(static_cast<double>(f[i]));
+    }
+  }
+  return out;
+}
+
+TEST(IoFrames, EveryFieldReadsBackAsWrittenWithoutGhosts) {
+  TempFolder tmp;
+  const Simulation sim = small_dam();
+  const ParticleStore<2>& s = sim.store();
+  ASSERT_GT(sim.diagnostics().ghosts, 0u);
+  const fs::path file = tmp.path() / "frame.h5";
+  const io::FrameHeader h = io::write_frame(file, "frame_000003", s, sim.time(), sim.step_count(), 3, {});
+  EXPECT_FALSE(fs::exists(io::temporary_path(file)));
+
+  const auto keep = non_ghosts(s);
+  EXPECT_EQ(h.particles, keep.size());
+  const io::FrameHeader r = io::read_frame_header(file, "frame_000003");
+  EXPECT_EQ(r.time, sim.time());
+  EXPECT_EQ(r.step, sim.step_count());
+  EXPECT_EQ(r.index, 3u);
+  EXPECT_EQ(r.particles, keep.size());
+  EXPECT_EQ(r.fields, io::field_layouts());
+  int fields = 0;
+  s.for_each_field([&](const auto& f) {
+    const std::string name(f.name());
+    EXPECT_EQ(io::read_frame_field(file, "frame_000003", name), as_doubles(f, keep)) << name;
+    ++fields;
+  });
+  EXPECT_EQ(fields, 14);
+}
+
+TEST(IoFrames, SelectedFieldsAlwaysIncludePosition) {
+  TempFolder tmp;
+  const Simulation sim = small_dam();
+  const fs::path file = tmp.path() / "frame.h5";
+  const io::FrameHeader h = io::write_frame(file, "g", sim.store(), 0.0, 0, 0, {"density", "level"});
+  ASSERT_EQ(h.fields.size(), 3u);
+  EXPECT_EQ(h.fields[0].name, "position");
+  EXPECT_EQ(io::read_frame_header(file, "g").fields.size(), 3u);
+  EXPECT_THROW((void)io::read_frame_field(file, "g", "velocity"), std::runtime_error);
+}
+
+TEST(IoFrames, XdmfDatasetPathsAndShapesMatchTheHdf5Files) {
+  TempFolder tmp;
+  Simulation sim = small_dam();
+  const io::RunFiles files{tmp.path()};
+  fs::create_directories(files.frames());
+  std::vector<io::XdmfEntry> entries;
+  for (std::uint64_t k = 0; k < 3; ++k) {
+    const io::FrameHeader h = io::write_frame(files.frame(k), io::RunFiles::frame_group(k), sim.store(), sim.time(),
+                                              sim.step_count(), k, {});
+    entries.push_back({"frames/" + io::RunFiles::frame_file_name(k), h});
+    sim.step();
+  }
+  io::write_xdmf(files.xdmf(), entries);
+  const std::string xml = io::read_file(files.xdmf());
+
+  // One uniform grid per frame, in a temporal collection, each with its time.
+  const std::regex grid(R"re(<Grid Name="(frame_\d{6})" GridType="Uniform">\s*<Time Value="([^"]+)"/>\s*<Topology TopologyType="Polyvertex" Dimensions="(\d+)"/>)re");
+  int grids = 0;
+  for (auto it = std::sregex_iterator(xml.begin(), xml.end(), grid); it != std::sregex_iterator(); ++it, ++grids) {
+    EXPECT_EQ((*it)[1].str(), entries[static_cast<std::size_t>(grids)].frame.group);
+    EXPECT_EQ(std::stod((*it)[2].str()), entries[static_cast<std::size_t>(grids)].frame.time);
+    EXPECT_EQ(std::stoull((*it)[3].str()), entries[static_cast<std::size_t>(grids)].frame.particles);
+  }
+  EXPECT_EQ(grids, 3);
+  EXPECT_NE(xml.find("CollectionType=\"Temporal\""), std::string::npos);
+  EXPECT_NE(xml.find("<Geometry GeometryType=\"XY\">"), std::string::npos);
+
+  // Every DataItem names an existing dataset whose size matches its Dimensions.
+  const std::regex item(R"re(<DataItem Dimensions="(\d+)( (\d+))?" NumberType="(\w+)" Precision="(\d)" Format="HDF">([^:<]+):(/[^<]+)</DataItem>)re");
+  int items = 0;
+  for (auto it = std::sregex_iterator(xml.begin(), xml.end(), item); it != std::sregex_iterator(); ++it, ++items) {
+    const std::size_t n = std::stoull((*it)[1].str());
+    const std::size_t components = (*it)[3].matched ? std::stoull((*it)[3].str()) : 1;
+    const fs::path file = tmp.path() / (*it)[6].str();
+    const std::string dataset = (*it)[7].str();
+    const std::size_t slash = dataset.rfind('/');
+    ASSERT_TRUE(fs::exists(file)) << file;
+    const auto values = io::read_frame_field(file, dataset.substr(1, slash - 1), dataset.substr(slash + 1));
+    EXPECT_EQ(values.size(), n * components) << dataset;
+  }
+  EXPECT_EQ(items, 3 * 14);
+}
+
+TEST(IoFrames, CheckpointRestoresEveryFieldAndTheNextId) {
+  TempFolder tmp;
+  Simulation sim = small_dam();
+  sim.store().take_ids(17);  // a next id beyond the particles, as after refinement
+  io::CheckpointState state;
+  state.time = sim.time();
+  state.step = sim.step_count();
+  state.dt = sim.dt();
+  state.next_id = sim.store().next_id();
+  state.next_row = 4;
+  state.next_frame = 2;
+  state.frame_count = 2;
+  state.scene = R"({"name": "x"})";
+  const fs::path file = tmp.path() / "checkpoint.h5";
+  io::write_checkpoint(file, sim.store(), state);
+
+  ParticleStore<2> back;
+  const io::CheckpointState r = io::read_checkpoint(file, back);
+  EXPECT_EQ(r.time, state.time);
+  EXPECT_EQ(r.step, state.step);
+  EXPECT_EQ(r.dt, state.dt);
+  EXPECT_EQ(r.next_row, 4u);
+  EXPECT_EQ(r.frame_count, 2u);
+  EXPECT_EQ(r.scene, state.scene);
+  EXPECT_EQ(back.next_id(), sim.store().next_id());
+  const auto keep = non_ghosts(sim.store());
+  ASSERT_EQ(back.size(), keep.size());
+  std::vector<std::vector<double>> a, b;
+  sim.store().for_each_field([&](const auto& f) { a.push_back(as_doubles(f, keep)); });
+  std::vector<std::size_t> all(back.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  back.for_each_field([&](const auto& f) { b.push_back(as_doubles(f, all)); });
+  EXPECT_EQ(a, b);
+}
+
+TEST(IoFrames, ReadingAMissingOrForeignFileThrows) {
+  TempFolder tmp;
+  ParticleStore<2> s;
+  EXPECT_THROW((void)io::read_checkpoint(tmp.path() / "nope.h5", s), std::runtime_error);
+  io::write_file_atomic(tmp.path() / "text.h5", "not hdf5");
+  EXPECT_THROW((void)io::read_checkpoint(tmp.path() / "text.h5", s), std::runtime_error);
+  const Simulation sim = small_dam();
+  (void)io::write_frame(tmp.path() / "frame.h5", "frame_000000", sim.store(), 0.0, 0, 0, {});
+  EXPECT_THROW((void)io::read_checkpoint(tmp.path() / "frame.h5", s), std::runtime_error);
+}
+
+TEST(IoFrames, AtomicWriteReplacesWholeFiles) {
+  TempFolder tmp;
+  const fs::path f = tmp.path() / "a.txt";
+  io::write_file_atomic(f, "first");
+  io::write_file_atomic(f, "second");
+  EXPECT_EQ(io::read_file(f), "second");
+  EXPECT_FALSE(fs::exists(io::temporary_path(f)));
+}
+
+}  // namespace

@@ -1,0 +1,203 @@
+// A scene run with its outputs: writing output does not change the run (bitwise), the folder holds the
+// series, frames, XDMF, resolved scene and summary with no temporary file left, and a run resumed from a
+// checkpoint (in a copy of the folder taken after the checkpoint, as if killed then) ends bitwise identical
+// to the uninterrupted run, with the same time series and XDMF.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <sstream>
+#include <string>
+
+#include "core/io/atomic_file.hpp"
+#include "core/io/hdf5_frames.hpp"
+#include "core/scene/runner.hpp"
+#include "core/scene/scene_parser.hpp"
+
+namespace {
+
+using namespace sph;
+namespace fs = std::filesystem;
+
+/// These tests check set-up and I/O, not threading (the determinism tests run 1 and N threads): one thread
+/// keeps them fast when the machine is shared.
+class OneThread : public ::testing::Environment {
+ public:
+  void SetUp() override { omp_set_num_threads(1); }
+};
+[[maybe_unused]] ::testing::Environment* const kOneThread = ::testing::AddGlobalTestEnvironment(new OneThread);
+
+class TempFolder {
+ public:
+  TempFolder() {
+    path_ = fs::temp_directory_path() / ("sph_test_runner_" + std::to_string(::getpid()) + "_" +
+                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempFolder() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+/// A small dam break with every effect and dynamic refinement that fires during the run.
+scene::Scene tiny_scene() {
+  return scene::scene_from_json(scene::parse_json_text(R"({
+    "name": "tiny",
+    "container": { "lo": [0, 0], "hi": [4, 3] },
+    "fluid": [ { "shape": "rectangle", "lo": [0, 0], "hi": [1, 2], "spacing": 0.1, "hydrostatic": true } ],
+    "material": { "rho0": 1000, "mach_factor": 10, "reference_height": 2 },
+    "effects": {
+      "gravity": [0, -9.81],
+      "artificial_viscosity": { "alpha": 0.02 },
+      "lennard_jones_wall": { "reference_height": 2 },
+      "ghost_walls": "free-slip",
+      "refinement": { "criterion": "velocity", "v_threshold": 0.4, "check_interval": 20, "max_level": 1 }
+    },
+    "time": { "end": 0.08, "output_interval": 0.01 },
+    "probes": [ { "type": "water_height", "name": "H", "x": 0 }, { "type": "surge_front", "name": "Z" },
+                { "type": "pressure", "name": "p", "position": [0.5, 0.1] } ],
+    "output": { "frame_interval": 0.02 }
+  })",
+                                                       "tiny"));
+}
+
+void expect_bitwise_equal(const ParticleStore<2>& a, const ParticleStore<2>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(a.next_id(), b.next_id());
+  std::vector<std::vector<unsigned char>> fa, fb;
+  auto collect = [](std::vector<std::vector<unsigned char>>& out) {
+    return [&out](const auto& f) {
+      const auto* p = reinterpret_cast<const unsigned char*>(f.data());
+      out.emplace_back(p, p + f.size() * sizeof(*f.data()));
+    };
+  };
+  a.for_each_field(collect(fa));
+  b.for_each_field(collect(fb));
+  std::vector<std::string> names;
+  a.for_each_field([&](const auto& f) { names.emplace_back(f.name()); });
+  for (std::size_t k = 0; k < fa.size(); ++k) EXPECT_TRUE(fa[k] == fb[k]) << "field " << names[k] << " differs";
+}
+
+std::vector<std::string> lines(const fs::path& file) {
+  std::istringstream in(io::read_file(file));
+  std::vector<std::string> out;
+  for (std::string l; std::getline(in, l);) out.push_back(l);
+  return out;
+}
+
+bool has_temporary_files(const fs::path& folder) {
+  for (const auto& e : fs::recursive_directory_iterator(folder)) {
+    if (e.path().extension() == ".tmp") return true;
+  }
+  return false;
+}
+
+TEST(Runner, WritingOutputDoesNotChangeTheRun) {
+  TempFolder tmp;
+  scene::Runner with(tiny_scene(), scene::RunOptions{tmp.path() / "out", std::nullopt, 0.03});
+  scene::Runner without(tiny_scene(), scene::RunOptions{});
+  const scene::RunSummary a = with.run();
+  const scene::RunSummary b = without.run();
+  EXPECT_EQ(with.simulation().step_count(), without.simulation().step_count());
+  EXPECT_EQ(with.simulation().time(), without.simulation().time());
+  expect_bitwise_equal(with.simulation().store(), without.simulation().store());
+  ASSERT_GE(a.final.per_level.size(), 2u);
+  EXPECT_GT(a.final.per_level[1], 0u) << "refinement should have fired";
+  EXPECT_EQ(a.particle_steps, b.particle_steps);
+  EXPECT_EQ(b.rows, 0u);
+  EXPECT_FALSE(fs::exists(tmp.path() / "nothing"));
+}
+
+TEST(Runner, FolderHoldsSeriesFramesXdmfSceneAndSummary) {
+  TempFolder tmp;
+  const scene::Scene s = tiny_scene();
+  const fs::path out = tmp.path() / "run";
+  scene::Runner runner(s, scene::RunOptions{out, std::nullopt, std::nullopt});
+  EXPECT_FALSE(fs::exists(out)) << "nothing is created before start()";
+  const scene::RunSummary r = runner.run();
+  const io::RunFiles files{out};
+  for (const auto& p : {files.scene(), files.series(), files.xdmf(), files.summary()}) EXPECT_TRUE(fs::exists(p)) << p;
+  EXPECT_FALSE(fs::exists(files.checkpoint()));
+  EXPECT_FALSE(has_temporary_files(out));
+  EXPECT_TRUE(files.holds_run());
+
+  // The resolved scene reads back as the scene that ran.
+  EXPECT_EQ(scene::load_scene(files.scene()), s);
+
+  // Rows at t = 0, 0.01, ..., and the end: 9 for 0.08 s (the end coincides with the last output time or
+  // adds one row).
+  const auto csv = lines(files.series());
+  ASSERT_FALSE(csv.empty());
+  EXPECT_EQ(csv[0].rfind("time,step,dt,fluid,ghosts,walls,level_0,level_1,mass,", 0), 0u) << csv[0];
+  EXPECT_NE(csv[0].find(",H,Z,p"), std::string::npos);
+  EXPECT_GE(csv.size() - 1, 9u);
+  EXPECT_LE(csv.size() - 1, 10u);
+  EXPECT_EQ(r.rows, csv.size() - 1);
+  EXPECT_EQ(csv[1].rfind("0,0,", 0), 0u);
+
+  // Frames at 0, 0.02, ..., 0.08 (+ the end if it is not one of them), densely numbered.
+  EXPECT_GE(r.frames, 5u);
+  for (std::uint64_t k = 0; k < r.frames; ++k) {
+    const io::FrameHeader h = io::read_frame_header(files.frame(k), io::RunFiles::frame_group(k));
+    EXPECT_EQ(h.index, k);
+    EXPECT_NEAR(h.time, std::min(0.02 * static_cast<double>(k), 0.08), 0.002);
+  }
+  EXPECT_FALSE(fs::exists(files.frame(r.frames)));
+}
+
+TEST(Runner, ResumedRunIsBitwiseIdenticalToTheUninterruptedOne) {
+  TempFolder tmp;
+  const scene::Scene s = tiny_scene();
+  const fs::path a_dir = tmp.path() / "a", c_dir = tmp.path() / "c";
+  scene::Runner a(s, scene::RunOptions{a_dir, std::nullopt, 0.035});
+  a.start();
+  const io::RunFiles a_files{a_dir};
+  while (!fs::exists(a_files.checkpoint())) a.advance();
+  const std::uint64_t checkpoint_step = a.simulation().step_count();
+  // Killed some steps after the checkpoint (a row and a frame past it already on disk): take the folder then.
+  while (a.simulation().time() < 0.05) a.advance();
+  fs::copy(a_dir, c_dir, fs::copy_options::recursive);
+  a.run();
+
+  scene::Runner c(s, scene::RunOptions{c_dir, c_dir / "checkpoint.h5", 0.035});
+  EXPECT_EQ(c.simulation().step_count(), checkpoint_step);
+  c.run();
+  EXPECT_EQ(c.simulation().step_count(), a.simulation().step_count());
+  EXPECT_EQ(c.simulation().time(), a.simulation().time());
+  expect_bitwise_equal(c.simulation().store(), a.simulation().store());
+  EXPECT_EQ(lines(c_dir / "series.csv"), lines(a_dir / "series.csv"));
+  EXPECT_EQ(io::read_file(c_dir / "frames.xdmf"), io::read_file(a_dir / "frames.xdmf"));
+  EXPECT_FALSE(has_temporary_files(c_dir));
+}
+
+TEST(Runner, ResumeRefusesACheckpointOfAnotherScene) {
+  TempFolder tmp;
+  scene::Scene s = tiny_scene();
+  s.time.end = 0.01;
+  scene::Runner a(s, scene::RunOptions{tmp.path() / "a", std::nullopt, 0.01});
+  a.run();
+  scene::Scene other = s;
+  other.h_factor = 1.5;
+  try {
+    scene::Runner b(other, scene::RunOptions{tmp.path() / "b", tmp.path() / "a" / "checkpoint.h5", std::nullopt});
+    FAIL() << "accepted";
+  } catch (const scene::SceneError& e) {
+    EXPECT_EQ(e.path(), "--resume");
+  }
+  // A longer end time is fine: the run continues.
+  scene::Scene longer = s;
+  longer.time.end = 0.02;
+  scene::Runner c(longer, scene::RunOptions{tmp.path() / "a", tmp.path() / "a" / "checkpoint.h5", std::nullopt});
+  c.run();
+  EXPECT_DOUBLE_EQ(c.simulation().time(), 0.02);
+}
+
+}  // namespace

@@ -1,0 +1,160 @@
+// Scene -> Simulation: the case files build exactly the programmatic cases (bitwise, and after steps), an
+// effect absent from the scene is absent from the solver, and refinement is wired in.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/case_builder.hpp"
+#include "core/scene/scene_builder.hpp"
+#include "core/scene/scene_parser.hpp"
+
+namespace {
+
+using namespace sph;
+
+/// These tests check set-up and I/O, not threading (the determinism tests run 1 and N threads): one thread
+/// keeps them fast when the machine is shared.
+class OneThread : public ::testing::Environment {
+ public:
+  void SetUp() override { omp_set_num_threads(1); }
+};
+[[maybe_unused]] ::testing::Environment* const kOneThread = ::testing::AddGlobalTestEnvironment(new OneThread);
+
+const std::filesystem::path kCases = std::filesystem::path(__FILE__).parent_path().parent_path() / "cases";
+
+/// Every field of the two stores, byte for byte.
+void expect_bitwise_equal(const ParticleStore<2>& a, const ParticleStore<2>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(a.next_id(), b.next_id());
+  std::vector<std::vector<unsigned char>> fa, fb;
+  auto collect = [](std::vector<std::vector<unsigned char>>& out) {
+    return [&out](const auto& f) {
+      const auto* p = reinterpret_cast<const unsigned char*>(f.data());
+      out.emplace_back(p, p + f.size() * sizeof(*f.data()));
+    };
+  };
+  a.for_each_field(collect(fa));
+  b.for_each_field(collect(fb));
+  std::vector<std::string> names;
+  a.for_each_field([&](const auto& f) { names.emplace_back(f.name()); });
+  ASSERT_EQ(fa.size(), fb.size());
+  for (std::size_t k = 0; k < fa.size(); ++k) EXPECT_TRUE(fa[k] == fb[k]) << "field " << names[k] << " differs";
+}
+
+void expect_same_settings(const SolverSettings& a, const SolverSettings& b) {
+  EXPECT_EQ(a.eos.rho0, b.eos.rho0);
+  EXPECT_EQ(a.eos.c0, b.eos.c0);
+  EXPECT_EQ(a.eos.gamma, b.eos.gamma);
+  EXPECT_EQ(a.gravity.has_value(), b.gravity.has_value());
+  if (a.gravity && b.gravity) {
+    EXPECT_EQ(*a.gravity, *b.gravity);
+  }
+  ASSERT_EQ(a.viscosity.has_value(), b.viscosity.has_value());
+  if (a.viscosity) {
+    EXPECT_EQ(a.viscosity->alpha, b.viscosity->alpha);
+    EXPECT_EQ(a.viscosity->beta, b.viscosity->beta);
+  }
+  ASSERT_EQ(a.lennard_jones.has_value(), b.lennard_jones.has_value());
+  if (a.lennard_jones) {
+    EXPECT_EQ(a.lennard_jones->strength, b.lennard_jones->strength);
+    EXPECT_EQ(a.lennard_jones->r0_factor, b.lennard_jones->r0_factor);
+    EXPECT_EQ(a.lennard_jones->spacing, b.lennard_jones->spacing);
+  }
+  EXPECT_EQ(a.ghosts, b.ghosts);
+  EXPECT_EQ(a.geometry.container.lo, b.geometry.container.lo);
+  EXPECT_EQ(a.geometry.container.hi, b.geometry.container.hi);
+  EXPECT_EQ(a.geometry.open_top, b.geometry.open_top);
+  EXPECT_EQ(a.cfl, b.cfl);
+  EXPECT_EQ(a.dt_max, b.dt_max);
+}
+
+void expect_same_run(Simulation scene_sim, Simulation reference, int steps) {
+  expect_same_settings(scene_sim.settings(), reference.settings());
+  EXPECT_STREQ(scene_sim.sweep_name(), reference.sweep_name());
+  expect_bitwise_equal(scene_sim.store(), reference.store());
+  EXPECT_EQ(scene_sim.dt(), reference.dt());
+  for (int k = 0; k < steps; ++k) {
+    scene_sim.step();
+    scene_sim.run_stages();
+    reference.step();
+    reference.run_stages();
+  }
+  expect_bitwise_equal(scene_sim.store(), reference.store());
+  EXPECT_EQ(scene_sim.time(), reference.time());
+}
+
+TEST(SceneBuilder, DamBreakCaseIsMakeDamBreak) {
+  const scene::Scene s = scene::load_scene(kCases / "dam_break.json");
+  expect_same_run(scene::build_simulation(s), make_dam_break(DamBreakSpec{}), 20);
+}
+
+TEST(SceneBuilder, DropCaseIsMakeDrop) {
+  const scene::Scene s = scene::load_scene(kCases / "drop.json");
+  expect_same_run(scene::build_simulation(s), make_drop(DropSpec{}), 20);
+}
+
+TEST(SceneBuilder, StillTankCaseIsMakeStillTank) {
+  const scene::Scene s = scene::load_scene(kCases / "still_tank.json");
+  expect_same_run(scene::build_simulation(s), make_still_tank(TankSpec{}), 20);
+}
+
+TEST(SceneBuilder, AbsentEffectsAreAbsentFromTheSolver) {
+  scene::Json doc = scene::read_json_file(kCases / "dam_break.json");
+  doc.erase("effects");
+  doc["fluid"][0].erase("hydrostatic");
+  doc["material"] = scene::Json{{"rho0", 1000}, {"c0", 50}};
+  const scene::Scene s = scene::scene_from_json(doc);
+  const SolverSettings settings = scene::solver_settings(s);
+  EXPECT_FALSE(settings.gravity);
+  EXPECT_FALSE(settings.viscosity);
+  EXPECT_FALSE(settings.lennard_jones);
+  EXPECT_FALSE(settings.ghosts);
+  const Simulation sim = scene::build_simulation(s);
+  EXPECT_STREQ(sim.sweep_name(), "continuity+pressure");
+  EXPECT_EQ(sim.diagnostics().walls, 0u);  // no Lennard-Jones: no wall particles
+  EXPECT_EQ(sim.diagnostics().ghosts, 0u);
+}
+
+TEST(SceneBuilder, StaticRefinementSplitsEveryParticle) {
+  const scene::Scene s = scene::load_scene(kCases / "dam_break_refined.json");
+  const Simulation sim = scene::build_simulation(s);
+  const Diagnostics d = sim.diagnostics();
+  ASSERT_EQ(d.per_level.size(), 2u);
+  EXPECT_EQ(d.per_level[0], 0u);
+  EXPECT_EQ(d.per_level[1], 3600u);  // the paper's fully refined 60 x 60
+  EXPECT_NEAR(d.mass, 1000.0 * 25.0 * 25.0, 1e-6);
+  EXPECT_EQ(sim.settings().lennard_jones->spacing, 25.0 / 30.0 / 4.0);  // half the finest spacing
+}
+
+TEST(SceneBuilder, StaticRefinementOfABoxSplitsOnlyInside) {
+  scene::Json doc = scene::read_json_file(kCases / "dam_break.json");
+  doc["effects"]["static_refinement"] = scene::Json{{"box", {{"lo", {0, 0}}, {"hi", {5, 5}}}}};
+  const Simulation sim = scene::build_simulation(scene::scene_from_json(doc));
+  const Diagnostics d = sim.diagnostics();
+  ASSERT_EQ(d.per_level.size(), 2u);
+  EXPECT_EQ(d.per_level[1], 4u * 36u);  // the 6 x 6 particles of [0, 5]^2, four daughters each
+  EXPECT_EQ(d.per_level[0], 900u - 36u);
+}
+
+TEST(SceneBuilder, DynamicRefinementStageRefinesFastParticles) {
+  // A zone criterion checked every step refines the particles in the zone at the first check.
+  scene::Json doc = scene::read_json_file(kCases / "dam_break_aap.json");
+  doc["effects"]["refinement"] = scene::Json{{"criterion", "zone"},
+                                             {"zone", {{"lo", {0, 0}}, {"hi", {5, 5}}}},
+                                             {"check_interval", 1},
+                                             {"max_level", 1}};
+  Simulation sim = scene::build_simulation(scene::scene_from_json(doc));
+  EXPECT_EQ(sim.diagnostics().per_level.size(), 1u);
+  sim.step();
+  sim.run_stages();
+  const Diagnostics d = sim.diagnostics();
+  ASSERT_EQ(d.per_level.size(), 2u);
+  EXPECT_GT(d.per_level[1], 0u);
+  EXPECT_EQ(d.per_level[1] % 4, 0u);
+}
+
+}  // namespace

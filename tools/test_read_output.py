@@ -1,0 +1,122 @@
+#!/usr/bin/python3
+"""ctest check of tools/read_output.py: run sphrefine on a tiny scene, then read its output with h5py.
+
+    /usr/bin/python3 tools/test_read_output.py PATH/TO/sphrefine
+
+Checks that the reader finds every row, every frame and every field, that the XDMF's datasets exist with
+the announced shapes, that frame attributes agree with the time series, and that the command-line reader
+exits 0 on the run and 1 on a folder whose frame went missing. Exit status 0 on success, 1 on failure.
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import read_output  # noqa: E402
+
+SCENE = {
+    "name": "tiny",
+    "container": {"lo": [0, 0], "hi": [4, 3]},
+    "fluid": [{"shape": "rectangle", "lo": [0, 0], "hi": [1, 2], "spacing": 0.1, "hydrostatic": True}],
+    "material": {"rho0": 1000, "mach_factor": 10, "reference_height": 2},
+    "effects": {
+        "gravity": [0, -9.81],
+        "artificial_viscosity": {"alpha": 0.02},
+        "lennard_jones_wall": {"reference_height": 2},
+        "ghost_walls": "free-slip",
+        "refinement": {"criterion": "velocity", "v_threshold": 0.4, "check_interval": 20, "max_level": 1},
+    },
+    "time": {"end": 0.04, "output_interval": 0.005},
+    "probes": [{"type": "water_height", "name": "H", "x": 0}, {"type": "surge_front", "name": "Z"}],
+    "output": {"frame_interval": 0.01},
+}
+
+FIELDS = ["acceleration", "density", "density_half", "density_rate", "id", "kind", "level", "mass", "position",
+          "pressure", "smoothing_length", "spacing", "velocity", "velocity_half"]
+
+
+def main():
+    if len(sys.argv) != 2:
+        print(__doc__, file=sys.stderr)
+        return 2
+    exe = sys.argv[1]
+    failures = []
+
+    def check(cond, what):
+        if not cond:
+            failures.append(what)
+            print("FAIL:", what)
+
+    tmp = tempfile.mkdtemp(prefix="sph_test_read_output_")
+    try:
+        scene = os.path.join(tmp, "tiny.json")
+        with open(scene, "w") as f:
+            json.dump(SCENE, f)
+        out = os.path.join(tmp, "run")
+        env = dict(os.environ, OMP_NUM_THREADS="1")
+        r = subprocess.run([exe, "run", scene, "-o", out, "-q"], capture_output=True, text=True, env=env)
+        check(r.returncode == 0, f"sphrefine run exited {r.returncode}: {r.stderr}")
+        if r.returncode != 0:
+            return 1
+
+        s = read_output.summarize(out)
+        series = read_output.load_series(out)
+        check(s["scene"] == "tiny", "scene name")
+        check(s["finished"], "run.json written")
+        check(s["problems"] == [], f"XDMF problems: {s['problems']}")
+        check(s["rows"] >= 9, f"rows {s['rows']}")
+        check(abs(series["time"][-1] - 0.04) < 1e-12, "last row at the end time")
+        check(np.all(np.diff(series["step"]) > 0), "steps increase")
+        check(np.allclose(series["mass"], series["mass"][0], rtol=1e-12), "mass conserved")
+        check(abs(series["H"][0] - 2.0) < 1e-9 and abs(series["Z"][0] - 1.0) < 1e-9, "probes at t = 0: H = 2, Z = 1")
+        check(s["frames"] == 5 and s["xdmf_frames"] == 5, f"frames {s['frames']} / {s.get('xdmf_frames')}")
+
+        files = read_output.frame_files(out)
+        rows_by_step = {int(st): k for k, st in enumerate(series["step"])}
+        for k, path in enumerate(files):
+            fr = read_output.load_frame(path)
+            check(fr["frame"] == k and fr["group"] == f"frame_{k:06d}", f"frame {k} numbering")
+            check(sorted(fr["fields"]) == FIELDS, f"frame {k} fields {sorted(fr['fields'])}")
+            n = fr["particles"]
+            check(fr["fields"]["position"].shape == (n, 2) and fr["fields"]["velocity"].shape == (n, 2), "vector shapes")
+            for name in FIELDS:
+                check(len(fr["fields"][name]) == n, f"frame {k} {name} length")
+            kinds = fr["fields"]["kind"]
+            check(not np.any(kinds == 2), "no ghosts in frames")
+            fluid = kinds == 0
+            row = rows_by_step.get(int(fr["step"]))
+            check(row is not None, f"frame {k} at a row's step")
+            if row is not None:
+                check(abs(series["time"][row] - fr["time"]) < 1e-15, f"frame {k} time matches its row")
+                check(int(series["fluid"][row]) == int(fluid.sum()), f"frame {k} fluid count")
+                m = fr["fields"]["mass"][fluid]
+                check(abs(m.sum() - series["mass"][row]) <= 1e-9 * series["mass"][row], f"frame {k} mass")
+            ids = fr["fields"]["id"]
+            check(len(np.unique(ids)) == len(ids), f"frame {k} ids unique")
+        last = read_output.load_frame(files[-1])
+        check(np.any(last["fields"]["level"][last["fields"]["kind"] == 0] == 1), "refinement reached the frames")
+
+        # The command-line reader: 0 on the run, 1 once a frame listed in the XDMF is gone, 2 on a non-run.
+        r = subprocess.run([sys.executable, os.path.join(HERE, "read_output.py"), out], capture_output=True, text=True)
+        check(r.returncode == 0 and "frames      5" in r.stdout, f"read_output.py: {r.returncode} {r.stdout} {r.stderr}")
+        broken = os.path.join(tmp, "broken")
+        shutil.copytree(out, broken)
+        os.remove(os.path.join(broken, "frames", "frame_000002.h5"))
+        r = subprocess.run([sys.executable, os.path.join(HERE, "read_output.py"), broken], capture_output=True, text=True)
+        check(r.returncode == 1 and "PROBLEM" in r.stdout, f"broken folder: {r.returncode}")
+        r = subprocess.run([sys.executable, os.path.join(HERE, "read_output.py"), tmp], capture_output=True, text=True)
+        check(r.returncode == 2, f"non-run folder: {r.returncode}")
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    print("test_read_output:", "FAILED" if failures else "passed", f"({len(failures)} failures)")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
