@@ -16,37 +16,16 @@
 #include "core/io/xdmf.hpp"
 #include "core/scene/scene_parser.hpp"
 
+#include "tests/support/io_helpers.hpp"
+
 namespace {
 
 using namespace sph;
+using test::TempFolder;
+using test::expect_bitwise_equal;
 namespace fs = std::filesystem;
 
-/// These tests check set-up and I/O, not threading (the determinism tests run 1 and N threads): one thread
-/// keeps them fast when the machine is shared.
-class OneThread : public ::testing::Environment {
- public:
-  void SetUp() override { omp_set_num_threads(1); }
-};
-[[maybe_unused]] ::testing::Environment* const kOneThread = ::testing::AddGlobalTestEnvironment(new OneThread);
 
-/// A fresh empty folder under the system temp directory, removed at the end of the test.
-class TempFolder {
- public:
-  TempFolder() {
-    path_ = fs::temp_directory_path() / ("sph_test_io_" + std::to_string(::getpid()) + "_" +
-                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempFolder() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
 
 /// A dam break a few steps in: fluid, wall and ghost particles, several levels of nothing special.
 Simulation small_dam() {

@@ -16,36 +16,16 @@
 #include "core/scene/runner.hpp"
 #include "core/scene/scene_parser.hpp"
 
+#include "tests/support/io_helpers.hpp"
+
 namespace {
 
 using namespace sph;
+using test::TempFolder;
+using test::expect_bitwise_equal;
 namespace fs = std::filesystem;
 
-/// These tests check set-up and I/O, not threading (the determinism tests run 1 and N threads): one thread
-/// keeps them fast when the machine is shared.
-class OneThread : public ::testing::Environment {
- public:
-  void SetUp() override { omp_set_num_threads(1); }
-};
-[[maybe_unused]] ::testing::Environment* const kOneThread = ::testing::AddGlobalTestEnvironment(new OneThread);
 
-class TempFolder {
- public:
-  TempFolder() {
-    path_ = fs::temp_directory_path() / ("sph_test_runner_" + std::to_string(::getpid()) + "_" +
-                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempFolder() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
 
 /// A small dam break with every effect and dynamic refinement that fires during the run.
 scene::Scene tiny_scene() {
@@ -69,22 +49,6 @@ scene::Scene tiny_scene() {
                                                        "tiny"));
 }
 
-void expect_bitwise_equal(const ParticleStore<2>& a, const ParticleStore<2>& b) {
-  ASSERT_EQ(a.size(), b.size());
-  EXPECT_EQ(a.next_id(), b.next_id());
-  std::vector<std::vector<unsigned char>> fa, fb;
-  auto collect = [](std::vector<std::vector<unsigned char>>& out) {
-    return [&out](const auto& f) {
-      const auto* p = reinterpret_cast<const unsigned char*>(f.data());
-      out.emplace_back(p, p + f.size() * sizeof(*f.data()));
-    };
-  };
-  a.for_each_field(collect(fa));
-  b.for_each_field(collect(fb));
-  std::vector<std::string> names;
-  a.for_each_field([&](const auto& f) { names.emplace_back(f.name()); });
-  for (std::size_t k = 0; k < fa.size(); ++k) EXPECT_TRUE(fa[k] == fb[k]) << "field " << names[k] << " differs";
-}
 
 std::vector<std::string> lines(const fs::path& file) {
   std::istringstream in(io::read_file(file));

@@ -12,38 +12,17 @@
 #include "core/scene/scene_builder.hpp"
 #include "core/scene/scene_parser.hpp"
 
+#include "tests/support/io_helpers.hpp"
+
 namespace {
 
 using namespace sph;
+using test::TempFolder;
+using test::expect_bitwise_equal;
 
-/// These tests check set-up and I/O, not threading (the determinism tests run 1 and N threads): one thread
-/// keeps them fast when the machine is shared.
-class OneThread : public ::testing::Environment {
- public:
-  void SetUp() override { omp_set_num_threads(1); }
-};
-[[maybe_unused]] ::testing::Environment* const kOneThread = ::testing::AddGlobalTestEnvironment(new OneThread);
 
 const std::filesystem::path kCases = std::filesystem::path(__FILE__).parent_path().parent_path() / "cases";
 
-/// Every field of the two stores, byte for byte.
-void expect_bitwise_equal(const ParticleStore<2>& a, const ParticleStore<2>& b) {
-  ASSERT_EQ(a.size(), b.size());
-  EXPECT_EQ(a.next_id(), b.next_id());
-  std::vector<std::vector<unsigned char>> fa, fb;
-  auto collect = [](std::vector<std::vector<unsigned char>>& out) {
-    return [&out](const auto& f) {
-      const auto* p = reinterpret_cast<const unsigned char*>(f.data());
-      out.emplace_back(p, p + f.size() * sizeof(*f.data()));
-    };
-  };
-  a.for_each_field(collect(fa));
-  b.for_each_field(collect(fb));
-  std::vector<std::string> names;
-  a.for_each_field([&](const auto& f) { names.emplace_back(f.name()); });
-  ASSERT_EQ(fa.size(), fb.size());
-  for (std::size_t k = 0; k < fa.size(); ++k) EXPECT_TRUE(fa[k] == fb[k]) << "field " << names[k] << " differs";
-}
 
 void expect_same_settings(const SolverSettings& a, const SolverSettings& b) {
   EXPECT_EQ(a.eos.rho0, b.eos.rho0);
