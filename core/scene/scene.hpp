@@ -99,6 +99,7 @@ struct Effects {
   std::optional<ArtificialViscosity> artificial_viscosity;
   std::optional<LennardJonesWall> lennard_jones_wall;
   std::optional<Slip> ghost_walls;
+  bool ghost_pressure_mirrored = false;  // ghost_pressure: "hydrostatic" (default) or "mirrored"
   std::optional<Refinement> refinement;
   std::optional<StaticRefinement> static_refinement;
   bool operator==(const Effects&) const = default;

@@ -239,7 +239,8 @@ StaticRefinement parse_static_refinement(const Json& j, const std::string& path)
 
 Effects parse_effects(const Json& j, const std::string& path) {
   ObjectReader r(j, path,
-                 {"gravity", "artificial_viscosity", "lennard_jones_wall", "ghost_walls", "refinement", "static_refinement"});
+                 {"gravity", "artificial_viscosity", "lennard_jones_wall", "ghost_walls", "ghost_pressure", "refinement",
+                  "static_refinement"});
   Effects e;
   if (r.has("gravity")) e.gravity = r.vec2("gravity");
   if (r.has("artificial_viscosity")) {
@@ -258,6 +259,9 @@ Effects parse_effects(const Json& j, const std::string& path) {
   }
   if (r.has("ghost_walls")) {
     e.ghost_walls = r.choice<Slip>("ghost_walls", {{"free-slip", Slip::free_slip}, {"no-slip", Slip::no_slip}}, std::nullopt);
+  }
+  if (r.has("ghost_pressure")) {
+    e.ghost_pressure_mirrored = r.choice<bool>("ghost_pressure", {{"hydrostatic", false}, {"mirrored", true}}, false);
   }
   if (r.has("refinement")) e.refinement = parse_refinement(r.at("refinement"), r.path("refinement"));
   if (r.has("static_refinement")) {
@@ -900,6 +904,7 @@ Json scene_to_json(const Scene& s) {
     e["lennard_jones_wall"] = w;
   }
   if (fx.ghost_walls) e["ghost_walls"] = to_string(*fx.ghost_walls);
+  e["ghost_pressure"] = fx.ghost_pressure_mirrored ? "mirrored" : "hydrostatic";
   if (fx.refinement) {
     const Refinement& r = *fx.refinement;
     Json o;
