@@ -101,23 +101,14 @@ class GhostBuilder {
           return 1u + static_cast<std::uint32_t>(images(view.x[i], view.v[i], view.h[i]).count);
         },
         &offsets);
-    // Source positions/velocities are needed after the gather overwrote them: read from a copy of view
-    // data through src (the first output of each source is its own copy).
+    // Every output starts as a copy of its source; the copies after the first become its ghosts, through
+    // make_ghost as in the solver's pipeline (so the ghost-pressure mode applies here too).
     store.gather(src);
     auto s = store.view();
     par::parallel_for(offsets.size() - 1, [&](std::size_t i) {
       const std::uint32_t first = offsets[i];
       const std::uint32_t count = offsets[i + 1] - first;
-      if (count <= 1) return;
-      const Images im = images(s.x[first], s.v[first], s.h[first]);
-      for (int g = 0; g < im.count; ++g) {
-        const std::size_t k = first + 1 + static_cast<std::size_t>(g);
-        s.x[k] = im.x[static_cast<std::size_t>(g)];
-        s.v[k] = im.v[static_cast<std::size_t>(g)];
-        s.kind[k] = Kind::ghost;
-        s.a[k].setZero();
-        s.drho[k] = 0.0;
-      }
+      for (std::uint32_t g = 1; g < count; ++g) make_ghost(s, first + g, static_cast<int>(g - 1));
     });
   }
 
