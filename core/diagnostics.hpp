@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include "core/equation_of_state.hpp"
@@ -118,6 +119,52 @@ inline Diagnostics compute_diagnostics(const ParticleStore<2>& store, const Tait
     ++d.per_level[l];
   }
   return d;
+}
+
+/// Stored energy of the Lennard-Jones wall repulsion (eq. 10), the potential of its force:
+///   E_LJ = sum over fluid i and wall particles j with r_ij < r0_i of m_i D/12 ((r0/r)^12 - 2 (r0/r)^6 + 1),
+/// r0_i = r0_factor d_i; -dphi/dr gives exactly the sweep's acceleration D ((r0/r)^12 - (r0/r)^6) / r and it
+/// is zero (and continuous) at r = r0. Add it to Diagnostics::total_energy() in runs with Lennard-Jones walls.
+/// Wall particles are binned once per call; each fluid particle sums its walls in store order and the
+/// particle sums are reduced deterministically, so the result does not depend on the thread count.
+inline double lennard_jones_energy(const ParticleStore<2>& store, double strength, double r0_factor) {
+  const auto& x = store.x.values();
+  const auto& kind = store.kind.values();
+  const auto& d = store.d.values();
+  const auto& m = store.m.values();
+  double r0max = 0.0;
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    if (kind[i] == Kind::fluid) r0max = std::max(r0max, r0_factor * d[i]);
+  }
+  if (!(r0max > 0.0)) return 0.0;
+  auto cell = [r0max](double c) { return static_cast<std::int64_t>(std::floor(c / r0max)); };
+  auto key = [](std::int64_t cx, std::int64_t cy) { return (cx << 32) ^ (cy & 0xffffffffLL); };
+  std::unordered_map<std::int64_t, std::vector<std::size_t>> bins;
+  for (std::size_t j = 0; j < store.size(); ++j) {
+    if (kind[j] == Kind::wall) bins[key(cell(x[j][0]), cell(x[j][1]))].push_back(j);
+  }
+  return par::reduce(
+      store.size(), 0.0,
+      [&](std::size_t i) {
+        if (kind[i] != Kind::fluid || !std::isfinite(x[i][0]) || !std::isfinite(x[i][1])) return 0.0;
+        const double r0 = r0_factor * d[i];
+        const std::int64_t cx = cell(x[i][0]), cy = cell(x[i][1]);
+        double e = 0.0;
+        for (std::int64_t bx = cx - 1; bx <= cx + 1; ++bx) {
+          for (std::int64_t by = cy - 1; by <= cy + 1; ++by) {
+            const auto it = bins.find(key(bx, by));
+            if (it == bins.end()) continue;
+            for (const std::size_t j : it->second) {
+              const double r2 = (x[i] - x[j]).squaredNorm();
+              if (r2 >= r0 * r0 || r2 <= 0.0) continue;
+              const double q2 = r0 * r0 / r2, q6 = q2 * q2 * q2;
+              e += q6 * q6 - 2.0 * q6 + 1.0;
+            }
+          }
+        }
+        return m[i] * strength / 12.0 * e;
+      },
+      [](double a, double b) { return a + b; });
 }
 
 }  // namespace sph

@@ -86,7 +86,10 @@ double Simulation::next_dt() const {
 StepInfo Simulation::step(double dt_cap) {
   const double dt = std::min(dt_, dt_cap);
   const bool watch = settings_.watchdog.enabled;
-  if (watch) last_good_ = store_;  // reuses capacity: no allocation once the sizes are stable
+  if (watch) {
+    last_good_ = store_;  // reuses capacity: no allocation once the sizes are stable
+    last_good_limits_ = limits_;
+  }
   const double half = 0.5 * dt;
   const TaitEquationOfState eos = settings_.eos;
   {
@@ -122,8 +125,12 @@ StepInfo Simulation::step(double dt_cap) {
       }
       report.step = step_ + 1;
       report.time = time_ + dt;
+      // Back to the last good state exactly: its particles with their rates (a, drho) and limits as they
+      // were, so dt_ (not yet advanced) and the next step are those of a run that never took the failed step.
+      // Only the grid is rebuilt for the restored particles (same order and ghosts; no rate re-evaluation).
       std::swap(store_, last_good_);
-      refresh();
+      limits_ = last_good_limits_;
+      prepare_neighbours();
       throw SimulationFailure(report);
     }
   }

@@ -96,6 +96,7 @@ class Simulation {
   std::vector<std::unique_ptr<Stage>> stages_;
   SweepLimits limits_;
   ParticleStore<2> last_good_;
+  SweepLimits last_good_limits_;  // limits_ of the last good state (restored with it)
   // Step workspace of prepare_neighbours (reused, so a step allocates nothing once sizes settle).
   std::vector<std::uint32_t> expand_src_, expand_offsets_, gather_src_;
   std::vector<std::int8_t> expand_image_, gather_image_;

@@ -2,8 +2,10 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "core/io/atomic_file.hpp"
@@ -59,7 +61,13 @@ Runner::Runner(Scene scene, RunOptions options)
     if (physics_of(original) != physics_of(scene_)) {
       throw SceneError("--resume", "the checkpoint was written by a different scene (only time, probes and output may change)");
     }
-    sim_.set_clock(state.time, state.step, state.dt);
+    // The first step after the checkpoint is the one it recorded; with a changed time.cfl (the way on after
+    // a watchdog stop) or dt_max it follows the new settings at once (dt = cfl * limit, capped by dt_max).
+    double dt = state.dt;
+    if (original.time.cfl != scene_.time.cfl || original.time.dt_max != scene_.time.dt_max) {
+      dt = std::min(state.dt / original.time.cfl * scene_.time.cfl, scene_.time.dt_max);
+    }
+    sim_.set_clock(state.time, state.step, dt);
     next_row_ = state.next_row;
     next_frame_ = state.next_frame;
     frame_count_ = state.frame_count;
@@ -131,6 +139,10 @@ void Runner::advance() {
   const double t0 = sim_.time();
   try {
     sim_.step(scene_.time.end - sim_.time());
+  } catch (const SimulationFailure& f) {
+    fail(f.report());  // the simulation is back at the last good state
+  }
+  try {
     sim_.run_stages();
   } catch (const std::exception& e) {
     throw std::runtime_error("the simulation failed at t = " + std::to_string(t0) + " s (step " +
@@ -219,9 +231,7 @@ void Runner::write_checkpoint() {
   ++checkpoints_;
 }
 
-RunSummary Runner::finish() {
-  if (!started_) start();
-  write_due_outputs(true);
+RunSummary Runner::summary() const {
   RunSummary r;
   r.wall_seconds = now_seconds() - wall_start_;
   r.steps = steps_run_;
@@ -234,27 +244,70 @@ RunSummary Runner::finish() {
   r.rows = rows_;
   r.frames = frames_written_;
   r.checkpoints = checkpoints_;
-  if (!options_.folder.empty()) {
-    Json j;
-    j["scene"] = scene_.name;
-    j["version"] = SPH_VERSION;
-    j["build_type"] = SPH_BUILD_TYPE;
-    j["threads"] = omp_get_max_threads();
-    j["sweep"] = sim_.sweep_name();
-    j["resumed"] = resumed_;
-    j["time"] = r.final.time;
-    j["step"] = r.final.step;
-    j["steps_this_run"] = r.steps;
-    j["wall_seconds"] = r.wall_seconds;
-    j["particle_steps"] = r.particle_steps;
-    j["particle_steps_per_second"] = r.wall_seconds > 0.0 ? static_cast<double>(r.particle_steps) / r.wall_seconds : 0.0;
-    j["fluid_per_level"] = r.final.per_level;
-    j["mass_drift"] = r.mass_drift;
-    j["momentum_change"] = r.momentum_change;
-    j["rows"] = r.rows;
-    j["frames"] = r.frames;
-    io::write_file_atomic(files_.summary(), j.dump(2) + "\n");
+  return r;
+}
+
+void Runner::write_summary(const RunSummary& r, const FailureReport* failure) {
+  if (options_.folder.empty()) return;
+  Json j;
+  j["scene"] = scene_.name;
+  j["version"] = SPH_VERSION;
+  j["build_type"] = SPH_BUILD_TYPE;
+  j["threads"] = omp_get_max_threads();
+  j["sweep"] = sim_.sweep_name();
+  j["resumed"] = resumed_;
+  j["status"] = failure ? "failed" : "completed";
+  j["time"] = r.final.time;
+  j["step"] = r.final.step;
+  j["steps_this_run"] = r.steps;
+  j["wall_seconds"] = r.wall_seconds;
+  j["particle_steps"] = r.particle_steps;
+  j["particle_steps_per_second"] = r.wall_seconds > 0.0 ? static_cast<double>(r.particle_steps) / r.wall_seconds : 0.0;
+  j["fluid_per_level"] = r.final.per_level;
+  j["mass_drift"] = r.mass_drift;
+  j["momentum_change"] = r.momentum_change;
+  j["rows"] = r.rows;
+  j["frames"] = r.frames;
+  if (failure) {
+    static constexpr const char* kinds[] = {"not_finite", "density", "left_domain"};
+    j["failure"] = {{"kind", kinds[static_cast<int>(failure->kind)]},
+                    {"step", failure->step},
+                    {"time", failure->time},
+                    {"particle", failure->id},
+                    {"position", {failure->position[0], failure->position[1]}},
+                    {"quantity", failure->quantity},
+                    {"cause", failure->cause},
+                    {"last_good_step", r.final.step},
+                    {"last_good_time", r.final.time},
+                    {"checkpoint", files_.checkpoint().filename().string()}};
   }
+  io::write_file_atomic(files_.summary(), j.dump(2) + "\n");
+}
+
+void Runner::fail(const FailureReport& report) {
+  std::string where;
+  if (!options_.folder.empty()) {
+    // The simulation holds the last good state: leave it behind, complete, for inspection and --resume.
+    const std::uint64_t step = sim_.step_count();
+    if (last_row_step_ != step) write_row();
+    if (scene_.output.frames && last_frame_step_ != step) write_frame();
+    write_checkpoint();
+    write_summary(summary(), &report);
+    char buf[96];
+    std::snprintf(buf, sizeof buf, " The last good state (step %llu, t = %.6g s) is in ",
+                  static_cast<unsigned long long>(step), sim_.time());
+    where = buf;
+    if (scene_.output.frames) where += (options_.folder / frames_.back().file).string() + " and ";
+    where += files_.checkpoint().string() + " (continue with --resume and a smaller time.cfl).";
+  }
+  throw RunFailure(report.message() + "." + where, report);
+}
+
+RunSummary Runner::finish() {
+  if (!started_) start();
+  write_due_outputs(true);
+  const RunSummary r = summary();
+  write_summary(r, nullptr);
   return r;
 }
 

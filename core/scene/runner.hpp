@@ -12,6 +12,8 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "core/diagnostics.hpp"
@@ -42,6 +44,19 @@ struct Progress {
   double wall_seconds = 0.0;       // since run() started
 };
 
+/// A run the watchdog stopped. By the time it is thrown the runner has written the last good state (the
+/// state before the failing step): a time-series row, a frame and a checkpoint, and run.json with
+/// "status": "failed" and the report. what() is one line: the report and where the last good state went.
+class RunFailure : public std::runtime_error {
+ public:
+  RunFailure(const std::string& message, FailureReport report)
+      : std::runtime_error(message), report_(std::move(report)) {}
+  const FailureReport& report() const { return report_; }
+
+ private:
+  FailureReport report_;
+};
+
 struct RunSummary {
   double wall_seconds = 0.0;
   std::uint64_t steps = 0;           // taken by this invocation
@@ -70,7 +85,8 @@ class Runner {
 
   /// Creates the output folder, writes the resolved scene and the first outputs (not when resuming).
   void start();
-  /// One step, the stages, and the outputs that fall due. Throws std::runtime_error if the run diverges.
+  /// One step, the stages, and the outputs that fall due. Throws RunFailure when the watchdog stops the run
+  /// (after writing the last good state), std::runtime_error if the run diverges otherwise.
   void advance();
   /// The last outputs, a checkpoint if requested, run.json; returns the summary.
   RunSummary finish();
@@ -85,6 +101,9 @@ class Runner {
   void write_row();
   void write_frame();
   void write_checkpoint();
+  RunSummary summary() const;
+  void write_summary(const RunSummary& r, const FailureReport* failure);
+  [[noreturn]] void fail(const FailureReport& report);
   std::size_t fluid_count() const;
 
   Scene scene_;
