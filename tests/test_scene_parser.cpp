@@ -241,6 +241,15 @@ TEST(SceneParser, MalformedJsonIsRefused) {
     EXPECT_NE(std::string(e.what()).find("line 1"), std::string::npos) << e.what();
   }
   EXPECT_THROW((void)parse_json_text("", "empty.json"), SceneError);
+  // A number past the range of a double is malformed text too (nlohmann reports it as out_of_range, not as a
+  // parse error: found by the fuzzer), named with the key it was read for.
+  try {
+    (void)parse_json_text(R"({ "time": { "end": 5.1e30802 } })", "huge.json");
+    FAIL() << "accepted";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("scene error: huge.json: malformed JSON: number overflow", 0), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("(in time.end)"), std::string::npos) << e.what();
+  }
   EXPECT_THROW((void)parse_json_text("[1, 2", "cut.json"), SceneError);
 }
 

@@ -166,6 +166,9 @@ double finest_spacing(const Scene& s);
 double wall_spacing(const Scene& s);
 /// The Lennard-Jones strength D (given, or 5 g H_ref).
 double lennard_jones_strength(const Scene& s);
+/// About how many particles the scene starts with: fluid (after a static refinement pass, which at most
+/// quadruples a region) and Lennard-Jones wall particles. What validation bounds, usable before building.
+double estimated_particles(const Scene& s);
 /// The largest level-0 spacing of the fluid regions (default probe band).
 double coarsest_spacing(const Scene& s);
 

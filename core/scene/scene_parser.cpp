@@ -482,6 +482,19 @@ double wall_spacing(const Scene& s) {
   return finest_spacing(s) / 2;
 }
 
+double estimated_particles(const Scene& s) {
+  double fluid = 0.0;
+  for (const auto& f : s.fluid) fluid += estimated_particles(f);
+  if (s.effects.static_refinement) fluid *= 4.0;
+  double walls = 0.0;
+  if (s.effects.lennard_jones_wall) {
+    double extent = 2.0 * (s.container.box.hi - s.container.box.lo).sum();
+    for (const auto& o : s.obstacles) extent += 2.0 * (o.hi - o.lo).sum();
+    walls = extent / wall_spacing(s);
+  }
+  return fluid + walls;
+}
+
 double lennard_jones_strength(const Scene& s) {
   if (!s.effects.lennard_jones_wall) return 0.0;
   const LennardJonesWall& w = *s.effects.lennard_jones_wall;
@@ -574,10 +587,13 @@ Json parse_json_text(const std::string& text, const std::string& source) {
   };
   try {
     return Json::parse(text, callback, /*allow_exceptions=*/true, /*ignore_comments=*/true);
-  } catch (const Json::parse_error& e) {
+  } catch (const Json::exception& e) {
+    // Syntax errors, and also numbers that do not fit a double (out_of_range, e.g. 1e400): both are malformed
+    // text, named with the key path reached so far.
     std::string what = e.what();
     if (what.rfind("[json.exception.", 0) == 0) what = what.substr(what.find(']') + 2);
-    fail(source, "malformed JSON: " + what);
+    const std::string at = path_to(stack.size());
+    fail(source, "malformed JSON: " + what + (at.empty() ? std::string() : " (in " + at + ")"));
   }
 }
 
