@@ -432,8 +432,17 @@ def main():
                         [("p*(sensor 1), t* >= 4", lambda r: r["p1_late"])]))
         md.append(f"\nExperiment, quasi-static pressure at sensor 1 (3 mm), mean over t* >= 4: p* = {p_exp_late:.3g}.\n")
 
-    with open(os.path.join(ROOT, "docs", "VALIDATION.md"), "w") as f:
-        f.write("\n".join(md))
+    # The stress section (tools/stress_report.py, scripts/stress) is another command's output: keep it.
+    doc = os.path.join(ROOT, "docs", "VALIDATION.md")
+    text = "\n".join(md)
+    begin, end = "<!-- stress:begin", "<!-- stress:end -->"
+    if os.path.exists(doc):
+        old = open(doc).read()
+        if begin in old and end in old:
+            text = text.rstrip("\n") + "\n\n" + old[old.index(begin):old.index(end) + len(end)] + "\n"
+    with open(doc + ".tmp", "w") as f:
+        f.write(text)
+    os.replace(doc + ".tmp", doc)
     print("wrote docs/VALIDATION.md and docs/figures/validation_*.png")
 
 
