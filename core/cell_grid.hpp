@@ -5,6 +5,12 @@
 //
 // Neighbour traversal visits, for particle i, every j != i with r_ij < 2 h_ij = h_i + h_j, in a fixed
 // order (cells in lexicographic order, particles in store order): deterministic at any thread count.
+//
+// The cell size is free: a query scans the cells that overlap the square [x_i - R_i, x_i + R_i]^D with
+// R_i = h_i + max_h, each row of cells along x as one contiguous run. Cells of the finest h (not of the largest
+// support) keep a fine particle among coarse ones from scanning coarse-sized cells: with mixed levels the
+// scanned area follows each particle's own reach, and a uniform set at cell = h scans (4h + h)^2 = 25 h^2
+// instead of the (3 x 2h)^2 = 36 h^2 of support-sized cells.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -32,12 +38,17 @@ class CellGrid {
     return std::min(kMaxCells, std::max<std::size_t>(std::size_t{1} << 16, 16 * n));
   }
 
-  /// Sorts particles into cells of size >= `min_cell_size` (give 2 max(h)). After this call, the store
-  /// must be gathered through order() before cell ranges refer to it.
-  void build(const VecD* x, std::size_t n, double min_cell_size) {
+  /// Sorts particles into cells of size >= `min_cell_size`. `max_h` is the largest smoothing length of
+  /// the particles (a query around particle i reaches h_i + max_h); by default min_cell_size / 2, the
+  /// classic cell = support. After this call, the store must be gathered through order() before cell ranges
+  /// refer to it.
+  void build(const VecD* x, std::size_t n, double min_cell_size, double max_h = -1.0) {
     if (!(min_cell_size > 0.0) || !std::isfinite(min_cell_size)) {
       throw std::invalid_argument("CellGrid::build: cell size must be positive and finite");
     }
+    if (max_h < 0.0) max_h = 0.5 * min_cell_size;
+    if (!std::isfinite(max_h)) throw std::invalid_argument("CellGrid::build: max_h must be finite");
+    max_h_ = max_h;
     n_ = n;
     struct Box {
       VecD lo, hi;
@@ -84,6 +95,8 @@ class CellGrid {
   const std::vector<std::uint32_t>& cell_start() const { return sorted_.bucket_start; }
 
   std::size_t cell_count() const { return cells_; }
+  /// The largest smoothing length the grid was built for: particle i's neighbours lie within h_i + max_h().
+  double max_h() const { return max_h_; }
   double cell_size() const { return cell_size_; }
   const std::array<std::int64_t, D>& dims() const { return dims_; }
   const VecD& origin() const { return origin_; }
@@ -106,37 +119,31 @@ class CellGrid {
 
   std::size_t cell_of(const VecD& p) const { return linear(coords(p)); }
 
-  /// Calls f(begin, end) for each contiguous run of candidate particles around point p (the 3^D
-  /// neighbouring cells; along x three cells form one run). Runs come in a fixed order.
+  /// Calls f(begin, end) for each contiguous run of candidate particles within `reach` of point p along
+  /// every axis: the cells overlapping [p - reach, p + reach]^D, each row along x one run. Runs come in a
+  /// fixed order (rows in memory order). coords() is monotone in p, so a particle with |x_j - p|_inf < reach
+  /// lies in a scanned cell; the reach is padded by rounding's worth to keep that true in floating point.
   template <class F>
-  void for_each_candidate_run(const VecD& p, F&& f) const {
-    const auto c = coords(p);
-    const std::int64_t x0 = std::max<std::int64_t>(c[0] - 1, 0);
-    const std::int64_t x1 = std::min<std::int64_t>(c[0] + 1, dims_[0] - 1);
+  void for_each_candidate_run(const VecD& p, double reach, F&& f) const {
+    const double r = reach * (1.0 + 1e-9) + 1e-15 * p.cwiseAbs().maxCoeff();
+    const auto lo = coords(p - VecD::Constant(r));
+    const auto hi = coords(p + VecD::Constant(r));
     const auto& start = sorted_.bucket_start;
+    const auto x_len = static_cast<std::size_t>(hi[0] - lo[0]);
     if constexpr (D == 1) {
-      f(start[static_cast<std::size_t>(x0)], start[static_cast<std::size_t>(x1) + 1]);
+      f(start[static_cast<std::size_t>(lo[0])], start[static_cast<std::size_t>(hi[0]) + 1]);
     } else {
-      std::array<std::int64_t, D> q = c;
-      // Iterate over the outer coordinates (1..D-1) in lexicographic order, offsets -1..1.
-      std::array<std::int64_t, D> off{};
-      for (int k = 1; k < D; ++k) off[k] = -1;
+      std::array<std::int64_t, D> q = lo;
       for (;;) {
-        bool inside = true;
-        for (int k = 1; k < D; ++k) {
-          q[k] = c[k] + off[k];
-          if (q[k] < 0 || q[k] >= dims_[k]) inside = false;
+        const std::size_t first = linear(q);
+        f(start[first], start[first + x_len + 1]);
+        int k = 1;
+        while (k < D && q[k] == hi[k]) {
+          q[k] = lo[k];
+          ++k;
         }
-        if (inside) {
-          q[0] = x0;
-          const std::size_t first = linear(q);
-          const std::size_t last = first + static_cast<std::size_t>(x1 - x0);
-          f(start[first], start[last + 1]);
-        }
-        int k = D - 1;
-        while (k >= 1 && off[k] == 1) off[k--] = -1;
-        if (k < 1) break;
-        ++off[k];
+        if (k == D) break;
+        ++q[k];
       }
     }
   }
@@ -146,7 +153,7 @@ class CellGrid {
   void for_each_neighbour(std::size_t i, const VecD* x, const double* h, F&& f) const {
     const VecD xi = x[i];
     const double hi = h[i];
-    for_each_candidate_run(xi, [&](std::uint32_t b, std::uint32_t e) {
+    for_each_candidate_run(xi, hi + max_h_, [&](std::uint32_t b, std::uint32_t e) {
       for (std::uint32_t j = b; j < e; ++j) {
         if (j == i) continue;
         const double r2 = (xi - x[j]).squaredNorm();
@@ -161,6 +168,7 @@ class CellGrid {
   std::size_t cells_ = 0;
   double cell_size_ = 1.0;
   double inv_cell_ = 1.0;
+  double max_h_ = 0.5;
   VecD origin_ = VecD::Zero();
   std::array<std::int64_t, D> dims_{};
   par::CountingSortResult sorted_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "parallel/parallel_for.hpp"
 
@@ -45,11 +46,17 @@ void Simulation::prepare_neighbours() {
     }
   });
   // 2. The cell sort of the expanded set, composed with the expansion into one source map.
+  // Cells of the finest smoothing length present; each particle's query reaches h_i + h_max (CellGrid).
   const auto h = view.h;
-  const double hmax = par::reduce(
-      n, 0.0, [&](std::size_t i) { return view.kind[i] == Kind::ghost ? 0.0 : h[i]; },
-      [](double a, double b) { return std::max(a, b); });
-  grid_.build(expand_x_.data(), m, std::max(2.0 * hmax, 1e-12));
+  struct Range {
+    double lo, hi;
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  const Range hr = par::reduce(
+      n, Range{inf, 0.0},
+      [&](std::size_t i) { return view.kind[i] == Kind::ghost ? Range{inf, 0.0} : Range{h[i], h[i]}; },
+      [](const Range& a, const Range& b) { return Range{std::min(a.lo, b.lo), std::max(a.hi, b.hi)}; });
+  grid_.build(expand_x_.data(), m, std::max(std::min(hr.lo, hr.hi), 1e-12), hr.hi);
   const auto& order = grid_.order();
   gather_src_.resize(m);
   gather_image_.resize(m);

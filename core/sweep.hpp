@@ -55,7 +55,7 @@ class PairSweep {
           const double hi = s.h[i];
           const double inv_hi = 1.0 / hi;
           pr.p_rho2_i = s.p[i] / (s.rho[i] * s.rho[i]);
-          grid.for_each_candidate_run(xi, [&](std::uint32_t b, std::uint32_t e) {
+          grid.for_each_candidate_run(xi, hi + grid.max_h(), [&](std::uint32_t b, std::uint32_t e) {
             for (std::uint32_t j = b; j < e; ++j) {
               const Vec<D> xij = xi - s.x[j];
               const double r2 = xij.squaredNorm();

@@ -55,10 +55,11 @@ struct Points {
 /// The grid's neighbour lists, mapped back to the caller's (unsorted) indices, each list sorted.
 /// Also checks that every reported r2 is the squared distance and that no pair is reported twice.
 template <int D>
-NeighbourLists grid_neighbours(const Points<D>& pts, double cell_size, CellGrid<D>* grid_out = nullptr) {
+NeighbourLists grid_neighbours(const Points<D>& pts, double cell_size, CellGrid<D>* grid_out = nullptr,
+                               double max_h = -1.0) {
   const std::size_t n = pts.x.size();
   CellGrid<D> grid;
-  grid.build(pts.x.data(), n, cell_size);
+  grid.build(pts.x.data(), n, cell_size, max_h);
   const auto& order = grid.order();
   EXPECT_EQ(order.size(), n);
   std::vector<Vec<D>> xs(n);
@@ -85,22 +86,28 @@ double max_h(const std::vector<double>& h) {
   return h.empty() ? 1.0 : *std::max_element(h.begin(), h.end());
 }
 
-/// Compares the grid against brute force with cell size 2 max(h), the size the build documents.
+/// Compares the grid against brute force with three cell sizes: 2 max(h) (cell = the largest support), min(h)
+/// with queries reaching h_i + max(h) (what the solver builds), and 0.37 min(h) (many rows per query).
 template <int D>
 void expect_neighbours_equal_brute_force(const Points<D>& pts, std::size_t min_pairs = 0) {
   const NeighbourLists expected = test::brute_force_neighbours<D>(pts.x, pts.h);
-  const NeighbourLists actual = grid_neighbours(pts, 2.0 * max_h(pts.h));
-  ASSERT_EQ(actual.size(), expected.size());
-  std::size_t mismatches = 0;
-  for (std::size_t i = 0; i < expected.size(); ++i) {
-    if (actual[i] != expected[i]) {
-      if (++mismatches <= 5) {
-        ADD_FAILURE() << "particle " << i << ": grid found " << actual[i].size()
-                      << " neighbours, brute force " << expected[i].size();
+  const double hmax = max_h(pts.h);
+  const double hmin = pts.h.empty() ? 1.0 : *std::min_element(pts.h.begin(), pts.h.end());
+  for (const double cell : {2.0 * hmax, hmin, 0.37 * hmin}) {
+    SCOPED_TRACE("cell size " + std::to_string(cell));
+    const NeighbourLists actual = grid_neighbours(pts, cell, static_cast<CellGrid<D>*>(nullptr), hmax);
+    ASSERT_EQ(actual.size(), expected.size());
+    std::size_t mismatches = 0;
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+      if (actual[i] != expected[i]) {
+        if (++mismatches <= 5) {
+          ADD_FAILURE() << "particle " << i << ": grid found " << actual[i].size()
+                        << " neighbours, brute force " << expected[i].size();
+        }
       }
     }
+    EXPECT_EQ(mismatches, 0u);
   }
-  EXPECT_EQ(mismatches, 0u);
   EXPECT_GE(test::pair_count(expected), min_pairs) << "the layout should produce pairs to compare";
 }
 

@@ -1,7 +1,9 @@
 #pragma once
 // Neighbour queries on the store as it stands between steps (positions have moved since the step's grid
 // was built): a cell grid built over the current positions without reordering the store.
+#include <algorithm>
 #include <cstdint>
+#include <limits>
 
 #include "core/cell_grid.hpp"
 #include "core/particle_store.hpp"
@@ -11,9 +13,13 @@ namespace sph::refine {
 class NeighbourQuery {
  public:
   explicit NeighbourQuery(const ParticleStore<2>& store) : store_(store) {
-    double hmax = 0.0;
-    for (std::size_t i = 0; i < store.size(); ++i) hmax = std::max(hmax, store.h[i]);
-    grid_.build(store.x.data(), store.size(), std::max(2.0 * hmax, 1e-12));
+    double hmax = 0.0, hmin = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < store.size(); ++i) {
+      hmax = std::max(hmax, store.h[i]);
+      hmin = std::min(hmin, store.h[i]);
+    }
+    // Cells of the finest h; each query reaches h_i + hmax (see CellGrid).
+    grid_.build(store.x.data(), store.size(), std::max(std::min(hmin, hmax), 1e-12), hmax);
   }
 
   /// Calls f(j, r) for every fluid particle j != i with r_ij < 2 h_ij, in a fixed order.
@@ -22,7 +28,7 @@ class NeighbourQuery {
     const auto& order = grid_.order();
     const Vec<2> xi = store_.x[i];
     const double hi = store_.h[i];
-    grid_.for_each_candidate_run(xi, [&](std::uint32_t b, std::uint32_t e) {
+    grid_.for_each_candidate_run(xi, hi + grid_.max_h(), [&](std::uint32_t b, std::uint32_t e) {
       for (std::uint32_t k = b; k < e; ++k) {
         const std::uint32_t j = order[k];
         if (j == i || store_.kind[j] != Kind::fluid) continue;
