@@ -111,7 +111,7 @@ def main():
         stderr = ""
         if os.path.exists(os.path.join(d, "stderr.txt")):
             with open(os.path.join(d, "stderr.txt")) as f:
-                stderr = f.read().strip()
+                stderr = f.read().strip().replace(ROOT + "/", "")
         code = status.get("exit_code")
         failed = code not in (0, None)
         out += ["### %s" % name, "", description(name), ""]
@@ -136,7 +136,8 @@ def main():
                 "| outcome | %s |" % ("completed" if not failed else "stopped (exit %s): %s" % (code, stderr.replace("|", "/"))),
                 "| simulated time | %s s |" % fmt(float(s["time"][-1]), ".4g"),
                 "| steps | %d |" % steps,
-                "| wall time | %s s |" % fmt(wall, ".1f"),
+                "| wall time | %s s (%s thread%s) |" % (fmt(wall, ".1f"), summary.get("threads", "-"),
+                                                     "" if summary.get("threads") == 1 else "s"),
                 "| max density error | %s |" % fmt(float(np.max(s["max_density_error"])), ".4f"),
                 "| energy drift E(end) - E(0) | %s J/m (%s of E(0)) |" % (fmt(float(e[-1] - e0), ".4g"), fmt(float((e[-1] - e0) / abs(e0)), ".2e")),
                 "| max energy rise | %s J/m (%s of E(0)) |" % (fmt(float(np.max(e - e0)), ".4g"), fmt(float(np.max(e - e0) / abs(e0)), ".2e")),
