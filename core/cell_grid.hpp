@@ -7,10 +7,11 @@
 // order (cells in lexicographic order, particles in store order): deterministic at any thread count.
 //
 // The cell size is free: a query scans the cells that overlap the square [x_i - R_i, x_i + R_i]^D with
-// R_i = h_i + max_h, each row of cells along x as one contiguous run. Cells of the finest h (not of the largest
-// support) keep a fine particle among coarse ones from scanning coarse-sized cells: with mixed levels the
-// scanned area follows each particle's own reach, and a uniform set at cell = h scans (4h + h)^2 = 25 h^2
-// instead of the (3 x 2h)^2 = 36 h^2 of support-sized cells.
+// R_i = h_i + max_h, each row of cells along x as one contiguous run. Cells sized by the finest support (not
+// the largest) keep a fine particle among coarse ones from scanning coarse-sized cells: with mixed levels the
+// scanned area follows each particle's own reach (a level-1 particle among level-0 ones scans 16 h0^2
+// instead of 36 h0^2). Smaller cells (h) would trim a uniform set's scan from 36 h^2 to 25 h^2 but measured
+// 3 % faster at 1e5 particles and 40 % slower at 1e6 (4x the cells to sort), so the solver uses 2 h_min.
 #include <algorithm>
 #include <array>
 #include <cmath>

@@ -46,6 +46,15 @@ class Field {
     std::swap(data_, scratch_);
   }
 
+  /// The three parts of gather(), for a store that gathers all its fields in one parallel region:
+  /// size the scratch (serial: it may allocate), fill it (from any thread), then swap it in.
+  T* gather_target(std::size_t m) {
+    scratch_.resize(m);
+    return scratch_.data();
+  }
+  T* gather_scratch() { return scratch_.data(); }
+  void gather_commit() { std::swap(data_, scratch_); }
+
   /// Frees the scratch buffer (after a one-off gather, to give memory back).
   void release_scratch() { std::vector<T>().swap(scratch_); }
 

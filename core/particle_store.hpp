@@ -4,6 +4,7 @@
 // output and checkpoints all go through it, so no field can be forgotten when particles move in memory.
 #include <cstddef>
 #include <cstdint>
+#include <tuple>
 #include <vector>
 
 #include "core/field.hpp"
@@ -55,10 +56,24 @@ class ParticleStore {
   Field<VecD> vh{"velocity_half"};
   Field<double> rhoh{"density_half"};
 
-  /// Visits every field (the registry). f is called with each Field<T>&.
+  /// The registry: every field as a pointer to member. Adding a field above and here is all it takes for
+  /// every operation (gather, compaction, expansion, copies, output, checkpoints) to carry it.
+  static constexpr auto field_members() {
+    return std::make_tuple(&ParticleStore::x, &ParticleStore::v, &ParticleStore::rho, &ParticleStore::p,
+                           &ParticleStore::m, &ParticleStore::h, &ParticleStore::d, &ParticleStore::level,
+                           &ParticleStore::kind, &ParticleStore::id, &ParticleStore::drho, &ParticleStore::a,
+                           &ParticleStore::vh, &ParticleStore::rhoh);
+  }
+
+  /// Visits every field. f is called with each Field<T>&.
   template <class F>
   void for_each_field(F&& f) {
-    f(x); f(v); f(rho); f(p); f(m); f(h); f(d); f(level); f(kind); f(id); f(drho); f(a); f(vh); f(rhoh);
+    std::apply([&](auto... member) { (f(this->*member), ...); }, field_members());
+  }
+  /// Visits every field of this store with the same field of `other`: f(Field<T>& mine, const Field<T>& theirs).
+  template <class F>
+  void for_each_field_with(const ParticleStore& other, F&& f) {
+    std::apply([&](auto... member) { (f(this->*member, other.*member), ...); }, field_members());
   }
   template <class F>
   void for_each_field(F&& f) const {
@@ -97,8 +112,41 @@ class ParticleStore {
 
   /// Every field := old field gathered through src (new[k] = old[src[k]]). The one primitive behind
   /// permutation (src a permutation), compaction (src increasing) and expansion (src repeats indices).
+  /// All fields in one parallel region (a worksharing loop per field, no barrier between them), not one
+  /// region per field: a step gathers every field once, and each region costs a fork and a barrier.
   void gather(const std::vector<std::uint32_t>& src) {
-    for_each_field([&](auto& f) { f.gather(src); });
+    const std::size_t new_size = src.size();
+    for_each_field([&](auto& f) { (void)f.gather_target(new_size); });
+    const auto count = static_cast<std::ptrdiff_t>(new_size);
+    const std::uint32_t* from = src.data();
+#pragma omp parallel
+    {
+      for_each_field([&](auto& f) {
+        auto* out = f.gather_scratch();
+        const auto* in = f.data();
+#pragma omp for schedule(static) nowait
+        for (std::ptrdiff_t k = 0; k < count; ++k) out[k] = in[from[k]];
+      });
+    }
+    for_each_field([&](auto& f) { f.gather_commit(); });
+  }
+
+  /// This store := a copy of `other`'s particles (values and next id; the scratch buffers are not copied),
+  /// every field in one parallel region. Reuses this store's capacity: no allocation once sizes settle.
+  void assign_from(const ParticleStore& other) {
+    const std::size_t n = other.size();
+    for_each_field([n](auto& f) { f.values().resize(n); });
+    const auto count = static_cast<std::ptrdiff_t>(n);
+#pragma omp parallel
+    {
+      for_each_field_with(other, [&](auto& mine, const auto& theirs) {
+        auto* out = mine.data();
+        const auto* in = theirs.data();
+#pragma omp for schedule(static) nowait
+        for (std::ptrdiff_t k = 0; k < count; ++k) out[k] = in[k];
+      });
+    }
+    next_id_ = other.next_id_;
   }
 
   /// Keeps the particles with keep(i), in order.

@@ -46,7 +46,8 @@ void Simulation::prepare_neighbours() {
     }
   });
   // 2. The cell sort of the expanded set, composed with the expansion into one source map.
-  // Cells of the finest smoothing length present; each particle's query reaches h_i + h_max (CellGrid).
+  // Cells as wide as the finest support present (2 h_min); each particle's query reaches h_i + h_max
+  // (CellGrid). A uniform set gets the classic support-sized cells.
   const auto h = view.h;
   struct Range {
     double lo, hi;
@@ -56,7 +57,7 @@ void Simulation::prepare_neighbours() {
       n, Range{inf, 0.0},
       [&](std::size_t i) { return view.kind[i] == Kind::ghost ? Range{inf, 0.0} : Range{h[i], h[i]}; },
       [](const Range& a, const Range& b) { return Range{std::min(a.lo, b.lo), std::max(a.hi, b.hi)}; });
-  grid_.build(expand_x_.data(), m, std::max(std::min(hr.lo, hr.hi), 1e-12), hr.hi);
+  grid_.build(expand_x_.data(), m, std::max(2.0 * std::min(hr.lo, hr.hi), 1e-12), hr.hi);
   const auto& order = grid_.order();
   gather_src_.resize(m);
   gather_image_.resize(m);
@@ -94,7 +95,7 @@ StepInfo Simulation::step(double dt_cap) {
   const double dt = std::min(dt_, dt_cap);
   const bool watch = settings_.watchdog.enabled;
   if (watch) {
-    last_good_ = store_;  // reuses capacity: no allocation once the sizes are stable
+    last_good_.assign_from(store_);  // reuses capacity: no allocation once the sizes are stable
     last_good_limits_ = limits_;
   }
   const double half = 0.5 * dt;

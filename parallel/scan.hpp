@@ -13,14 +13,14 @@ template <class T>
 T exclusive_scan(const T* in, T* out, std::size_t n) {
   const std::size_t chunks = chunk_count(n);
   std::vector<T> total(chunks + 1, T{});
-  parallel_for_dynamic(chunks, 1, [&](std::size_t c) {
+  parallel_for(chunks, [&](std::size_t c) {
     T acc{};
     const std::size_t end = std::min(n, (c + 1) * kChunk);
     for (std::size_t i = c * kChunk; i < end; ++i) acc += in[i];
     total[c + 1] = acc;
   });
   for (std::size_t c = 0; c < chunks; ++c) total[c + 1] += total[c];
-  parallel_for_dynamic(chunks, 1, [&](std::size_t c) {
+  parallel_for(chunks, [&](std::size_t c) {
     T acc = total[c];
     const std::size_t end = std::min(n, (c + 1) * kChunk);
     for (std::size_t i = c * kChunk; i < end; ++i) {

@@ -3,6 +3,7 @@
 // assigned generically through for_each_field, so a field added later is covered as soon as it is
 // registered (and a field of a new type fails to compile in value_for until the test learns the type).
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cstddef>
@@ -265,6 +266,30 @@ TYPED_TEST(ParticleStoreTest, ViewPointsAtTheFields) {
   EXPECT_EQ(v.a, s.a.data());
   EXPECT_EQ(v.vh, s.vh.data());
   EXPECT_EQ(v.rhoh, s.rhoh.data());
+}
+
+TYPED_TEST(ParticleStoreTest, AssignFromCopiesEveryFieldAndTheNextIdAtAnyThreadCount) {
+  constexpr int D = TestFixture::kDim;
+  // 10,007 particles: the static worksharing loops split unevenly across threads.
+  const ParticleStore<D> source = filled_store<D>(10007);
+  for (const int threads : {1, 2, 3}) {
+    SCOPED_TRACE(threads);
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(threads);
+    ParticleStore<D> copy = filled_store<D>(5);  // smaller: must grow
+    copy.set_next_id(3);
+    copy.assign_from(source);
+    omp_set_num_threads(saved);
+    EXPECT_EQ(copy.size(), source.size());
+    EXPECT_EQ(copy.next_id(), source.next_id());
+    EXPECT_EQ(ids_of(copy.id), ids_of(source.id));
+    EXPECT_EQ(inconsistent_entries(copy), 0u);
+    // And back down to a smaller store.
+    const ParticleStore<D> small = filled_store<D>(17);
+    copy.assign_from(small);
+    EXPECT_EQ(copy.size(), 17u);
+    EXPECT_EQ(inconsistent_entries(copy), 0u);
+  }
 }
 
 TEST(ParticleStore, GatherAllocatesNothingOnceAtSize) {

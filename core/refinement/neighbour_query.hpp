@@ -18,8 +18,8 @@ class NeighbourQuery {
       hmax = std::max(hmax, store.h[i]);
       hmin = std::min(hmin, store.h[i]);
     }
-    // Cells of the finest h; each query reaches h_i + hmax (see CellGrid).
-    grid_.build(store.x.data(), store.size(), std::max(std::min(hmin, hmax), 1e-12), hmax);
+    // Cells as wide as the finest support; each query reaches h_i + hmax (see CellGrid).
+    grid_.build(store.x.data(), store.size(), std::max(2.0 * std::min(hmin, hmax), 1e-12), hmax);
   }
 
   /// Calls f(j, r) for every fluid particle j != i with r_ij < 2 h_ij, in a fixed order.
