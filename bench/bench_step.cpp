@@ -4,6 +4,7 @@
 // without ghost walls. Args: {N, threads}.
 #include <benchmark/benchmark.h>
 #include <omp.h>
+#include <sys/resource.h>
 
 #include <cmath>
 
@@ -28,9 +29,19 @@ void BM_Step_DamBreak(benchmark::State& state, bool ghosts) {
   spec.ghosts = ghosts;
   Simulation sim = make_dam_break(spec);
   const std::size_t fluid = sim.diagnostics().fluid;
+  for (int k = 0; k < 3; ++k) sim.step();  // warm-up: the step's workspaces and the rollback copy reach size
   for (auto _ : state) sim.step();
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * fluid));
   state.counters["pairs_per_particle"] = static_cast<double>(sim.last_limits().pairs) / static_cast<double>(fluid);
+  state.counters["fluid"] = static_cast<double>(fluid);
+  state.counters["store_bytes_per_particle"] =
+      static_cast<double>(sim.store().bytes()) / static_cast<double>(fluid);
+  // Peak resident set of the process so far, per fluid particle: meaningful when a process runs one N
+  // (scripts/bench runs each N in its own process).
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  state.counters["peak_rss_bytes_per_particle"] =
+      static_cast<double>(usage.ru_maxrss) * 1024.0 / static_cast<double>(fluid);
 }
 
 void BM_Step_WithGhosts(benchmark::State& state) { BM_Step_DamBreak(state, true); }
@@ -56,7 +67,7 @@ void BM_Sweep_LennardJones(benchmark::State& s) { BM_Sweep_Effects(s, false, tru
 void BM_Sweep_ViscosityAndLennardJones(benchmark::State& s) { BM_Sweep_Effects(s, true, true); }
 
 void sizes(benchmark::internal::Benchmark* b) {
-  for (int64_t n : {10000, 100000, 1000000})
+  for (int64_t n : {1000, 10000, 100000, 1000000, 4000000})
     for (int64_t t : {1, 2}) b->Args({n, t});
 }
 
