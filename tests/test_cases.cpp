@@ -1,0 +1,179 @@
+// Case regressions: every case of cases/ and cases/validation/ runs to a fraction of its end time (a quarter;
+// a twentieth under the sanitizer preset) through the same Runner as the program, conserves mass exactly, and
+// its probes stay within a tolerance of the reference series of a full-length run stored in
+// tests/data/case_references/ (tools/case_references.py writes them). Rows are matched by step number: the
+// shortened run takes the same steps as the full one up to its end.
+//
+// Tolerances. The length probes (water height, surge front, surface elevation) are maxima of particle
+// positions over the body of water, so they move in steps of particles: a run that differs from the reference
+// only by rounding (summation order, compiler) stays within a fraction of a spacing over these short windows,
+// whereas a change to the physics (a force, the integrator, the refinement) moves the front or the column by
+// whole spacings within tenths of a second. Half the coarsest spacing separates the two. The pressure probe is
+// a kernel interpolation at a point carrying the weakly-compressible acoustic noise (a few per cent of the
+// hydrostatic scale rho0 g H from step to step): 5 % of rho0 g H, H the tallest fluid region's top above the
+// floor.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/scene/runner.hpp"
+#include "core/scene/scene_parser.hpp"
+#include "tests/support/io_helpers.hpp"
+#include "tests/support/test_scale.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace sph;
+
+const fs::path kRoot = fs::path(__FILE__).parent_path().parent_path();
+const fs::path kReferences = kRoot / "tests" / "data" / "case_references";
+
+struct Series {
+  std::vector<std::string> columns;
+  std::vector<std::vector<double>> rows;
+  std::size_t column(const std::string& name) const {
+    const auto it = std::find(columns.begin(), columns.end(), name);
+    return it == columns.end() ? columns.size() : static_cast<std::size_t>(it - columns.begin());
+  }
+};
+
+Series read_series(const fs::path& path) {
+  Series s;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) cells.push_back(cell);
+    if (s.columns.empty()) {
+      s.columns = cells;
+      continue;
+    }
+    std::vector<double> row;
+    for (const auto& c : cells) row.push_back(c == "nan" || c == "NaN" ? std::nan("") : std::stod(c));
+    s.rows.push_back(row);
+  }
+  return s;
+}
+
+fs::path scene_of(const std::string& name) {
+  for (const fs::path& p : {kRoot / "cases" / (name + ".json"), kRoot / "cases" / "validation" / (name + ".json")}) {
+    if (fs::exists(p)) return p;
+  }
+  return {};
+}
+
+std::vector<std::string> reference_names() {
+  std::vector<std::string> names;
+  if (!fs::exists(kReferences)) return names;
+  for (const auto& e : fs::directory_iterator(kReferences)) {
+    if (e.path().extension() == ".csv") names.push_back(e.path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+double fluid_height(const scene::Scene& s) {
+  double top = s.container.box.lo[1];
+  for (const auto& f : s.fluid) {
+    top = std::max(top, f.shape == scene::Shape::rectangle ? f.rect.hi[1] : f.centre[1] + f.radius);
+  }
+  return top - s.container.box.lo[1];
+}
+
+class CaseRegression : public testing::TestWithParam<std::string> {};
+
+TEST_P(CaseRegression, ShortRunConservesMassAndFollowsTheFullRun) {
+  const std::string name = GetParam();
+  const fs::path scene_path = scene_of(name);
+  ASSERT_FALSE(scene_path.empty()) << "no case file for the reference " << name;
+  const Series ref = read_series(kReferences / (name + ".csv"));
+  ASSERT_GT(ref.rows.size(), 4u) << name;
+
+  scene::Scene s = scene::load_scene(scene_path);
+  const double full_end = s.time.end;
+  s.time.output_interval = s.time.interval();  // the full run's (its default follows the end time)
+  s.time.end = full_end * (test::short_runs() ? 0.05 : 0.25);
+  s.output.frames = false;
+  const test::TempFolder tmp;
+  scene::RunOptions options;
+  options.folder = tmp.path() / "run";
+  scene::Runner runner(s, options);
+  runner.run();
+  const Series got = read_series(options.folder / "series.csv");
+  ASSERT_GT(got.rows.size(), 1u);
+
+  // Mass: exactly the initial mass in every row, and the reference's.
+  const std::size_t mass = got.column("mass");
+  ASSERT_LT(mass, got.columns.size());
+  const double m0 = got.rows.front()[mass];
+  EXPECT_EQ(m0, ref.rows.front()[ref.column("mass")]);
+  for (const auto& row : got.rows) {
+    EXPECT_EQ(row[mass], m0) << "t = " << row[0];
+  }
+
+  // Probes, row by row (matched by step; the last row of the short run ends on a capped step and is skipped).
+  const scene::Probes probes(s);
+  const double length_tol = 0.5 * scene::coarsest_spacing(s);
+  const double pressure_tol = 0.05 * s.material.rho0 * scene::gravity_magnitude(s) * fluid_height(s);
+  std::map<long long, std::size_t> ref_by_step;
+  const std::size_t ref_step = ref.column("step");
+  for (std::size_t r = 0; r < ref.rows.size(); ++r) ref_by_step[std::llround(ref.rows[r][ref_step])] = r;
+  std::size_t compared = 0;
+  for (std::size_t r = 0; r + 1 < got.rows.size(); ++r) {
+    const auto it = ref_by_step.find(std::llround(got.rows[r][got.column("step")]));
+    ASSERT_NE(it, ref_by_step.end()) << name << ": row " << r << " has a step the full run did not write";
+    const auto& want = ref.rows[it->second];
+    for (std::size_t k = 0; k < s.probes.size(); ++k) {
+      const std::string& column = probes.names()[k];
+      const std::size_t cg = got.column(column), cr = ref.column(column);
+      ASSERT_LT(cg, got.columns.size()) << column;
+      ASSERT_LT(cr, ref.columns.size()) << column;
+      const double a = got.rows[r][cg], b = want[cr];
+      if (std::isnan(a) || std::isnan(b)) {
+        EXPECT_EQ(std::isnan(a), std::isnan(b)) << name << " " << column << " at t = " << got.rows[r][0];
+        continue;
+      }
+      const double tol = s.probes[k].kind == scene::ProbeKind::pressure ? pressure_tol : length_tol;
+      EXPECT_NEAR(a, b, tol) << name << ": probe " << column << " at t = " << got.rows[r][0];
+      ++compared;
+    }
+  }
+  if (!s.probes.empty()) {
+    EXPECT_GT(compared, 0u) << name;
+  }
+  std::printf("[case] %s: t_end %.3g of %.3g s, %zu rows, %zu probe values compared (length tol %.3g m, pressure "
+              "tol %.3g Pa)\n",
+              name.c_str(), s.time.end, full_end, got.rows.size(), compared, length_tol, pressure_tol);
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, CaseRegression, testing::ValuesIn(reference_names()),
+                         [](const testing::TestParamInfo<std::string>& param_info) {
+                           std::string n = param_info.param;
+                           std::replace_if(n.begin(), n.end(), [](char c) { return !std::isalnum(c); }, '_');
+                           return n;
+                         });
+
+TEST(CaseReferences, EveryCaseHasAReference) {
+  // A new case file without a reference would silently escape the regression.
+  std::vector<std::string> missing;
+  for (const fs::path& dir : {kRoot / "cases", kRoot / "cases" / "validation"}) {
+    for (const auto& e : fs::directory_iterator(dir)) {
+      if (e.path().extension() != ".json") continue;
+      if (!fs::exists(kReferences / (e.path().stem().string() + ".csv"))) missing.push_back(e.path().filename());
+    }
+  }
+  EXPECT_TRUE(missing.empty()) << "run tools/case_references.py for: " << testing::PrintToString(missing);
+}
+
+}  // namespace
