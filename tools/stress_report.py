@@ -30,15 +30,7 @@ DOC = os.path.join(ROOT, "docs", "VALIDATION.md")
 BEGIN, END = "<!-- stress:begin (tools/stress_report.py) -->", "<!-- stress:end -->"
 SCENES = os.path.join(ROOT, "cases", "stress")
 
-
-def read_csv(path):
-    """A CSV with '#' comment lines and one header line -> dict of numpy columns."""
-    with open(path) as f:
-        lines = [l for l in f if l.strip() and not l.startswith("#")]
-    names = lines[0].strip().split(",")
-    rows = [[float(x) for x in l.strip().split(",")] for l in lines[1:]]
-    data = np.array(rows) if rows else np.zeros((0, len(names)))
-    return {n: data[:, k] for k, n in enumerate(names)}
+from validation_report import read_csv  # noqa: E402  (tools/ is the script's folder)
 
 
 def read_json(path):
