@@ -162,19 +162,27 @@ TEST(Watchdog, DensityErrorPastTheLimitIsCaughtAfterGoodSteps) {
   EXPECT_LE(std::abs(sim.store().rho[i] / s.eos.rho0 - 1.0), 0.5) << "the restored particle is within the limit";
 }
 
-TEST(Watchdog, ParticleLeavingTheDomainIsCaught) {
-  // No ghost walls and no wall particles: a block moving at 20 m/s towards the right wall goes through it.
+/// A block of fluid (spacing 0.5) moving at `velocity` in a 10 m x 10 m container with no walls of any kind
+/// (no ghosts, no wall particles) and no gravity.
+Simulation block_in_open_box(const Vec<2>& lo, const Vec<2>& hi, const Vec<2>& velocity, double c0) {
   SolverSettings s;
   s.gravity.reset();
   s.ghosts.reset();
-  s.eos.c0 = 200.0;
+  s.eos.c0 = c0;
   s.geometry.container = {Vec<2>(0, 0), Vec<2>(10, 10)};
   Simulation sim(s);
   FluidBlockSpec block;
   block.spacing = 0.5;
-  block.velocity = Vec<2>(20, 0);
-  add_fluid(sim.store(), lattice_rectangle(Vec<2>(6, 2), Vec<2>(9, 5), 0.5), block, s.eos.rho0);
+  block.velocity = velocity;
+  add_fluid(sim.store(), lattice_rectangle(lo, hi, 0.5), block, s.eos.rho0);
   sim.refresh();
+  return sim;
+}
+
+TEST(Watchdog, ParticleLeavingTheDomainIsCaught) {
+  // No ghost walls and no wall particles: a block moving at 20 m/s towards the right wall goes through it.
+  Simulation sim = block_in_open_box(Vec<2>(6, 2), Vec<2>(9, 5), Vec<2>(20, 0), 200.0);
+  const Geometry2& geometry = sim.settings().geometry;
   const FailureReport r = expect_failure(sim, FailureKind::left_domain, 100000);
   EXPECT_GT(sim.step_count(), 2u);
   EXPECT_GT(r.position[0], 10.0) << "the report gives the position outside the container";
@@ -183,23 +191,14 @@ TEST(Watchdog, ParticleLeavingTheDomainIsCaught) {
   // Restored: every fluid particle is back inside.
   for (std::size_t i = 0; i < sim.store().size(); ++i) {
     if (sim.store().kind[i] == Kind::fluid) {
-      EXPECT_TRUE(s.geometry.in_fluid_domain(sim.store().x[i]));
+      EXPECT_TRUE(geometry.in_fluid_domain(sim.store().x[i]));
     }
   }
 }
 
 TEST(Watchdog, RollbackLeavesARunnableSimulation) {
   // After a failure, lowering the step cap lets the run go on from the restored state.
-  SolverSettings s;
-  s.gravity.reset();
-  s.ghosts.reset();
-  s.geometry.container = {Vec<2>(0, 0), Vec<2>(10, 10)};
-  Simulation sim(s);
-  FluidBlockSpec block;
-  block.spacing = 0.5;
-  block.velocity = Vec<2>(1, 0);
-  add_fluid(sim.store(), lattice_rectangle(Vec<2>(4, 4), Vec<2>(6, 6), 0.5), block, s.eos.rho0);
-  sim.refresh();
+  Simulation sim = block_in_open_box(Vec<2>(4, 4), Vec<2>(6, 6), Vec<2>(1, 0), SolverSettings{}.eos.c0);
   auto& st = sim.store();
   std::size_t i = 0;
   while (st.kind[i] != Kind::fluid) ++i;
