@@ -73,17 +73,19 @@ class CellGrid {
     // (up to rounding) could otherwise land two cells apart and be missed. 1e-6 exceeds the rounding error
     // of (p - origin) * inv_cell for any coordinate below kMaxCells cells.
     cell_size_ = min_cell_size * (1.0 + 1e-6);
+    // The cell count is sized in floating point first: a far-flung particle (a run going wrong) can make the
+    // box so large that the count per axis does not fit an integer; the cells grow until it fits the budget.
+    const auto budget = static_cast<double>(cell_budget(n));
     for (;;) {
-      std::size_t total = 1;
-      for (int k = 0; k < D; ++k) {
-        dims_[k] = static_cast<std::int64_t>(std::floor((box.hi[k] - box.lo[k]) / cell_size_)) + 1;
-        total *= static_cast<std::size_t>(dims_[k]);
-      }
-      if (total <= cell_budget(n)) {
-        cells_ = total;
-        break;
-      }
-      cell_size_ *= 2.0;
+      double total = 1.0;
+      for (int k = 0; k < D; ++k) total *= std::floor((box.hi[k] - box.lo[k]) / cell_size_) + 1.0;
+      if (total <= budget) break;
+      cell_size_ *= total > 4.0 * budget ? 2.0 * std::pow(total / budget, 1.0 / D) : 2.0;
+    }
+    cells_ = 1;
+    for (int k = 0; k < D; ++k) {
+      dims_[k] = static_cast<std::int64_t>(std::floor((box.hi[k] - box.lo[k]) / cell_size_)) + 1;
+      cells_ *= static_cast<std::size_t>(dims_[k]);
     }
     origin_ = box.lo;
     inv_cell_ = 1.0 / cell_size_;

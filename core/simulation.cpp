@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "parallel/parallel_for.hpp"
 
@@ -112,9 +113,17 @@ StepInfo Simulation::step(double dt_cap) {
       s.p[i] = eos.pressure(s.rho[i]);
     });
   }
-  prepare_neighbours();
-  limits_ = sweep_->run(store_.view(), grid_);
-  {
+  // The drift can already have produced a non-finite position, which the grid refuses: with the watchdog on,
+  // that is reported (and undone) like any other failure of the step, naming the particle.
+  std::string step_error;
+  try {
+    prepare_neighbours();
+    limits_ = sweep_->run(store_.view(), grid_);
+  } catch (const std::exception& e) {
+    if (!watch) throw;
+    step_error = e.what();
+  }
+  if (step_error.empty()) {
     auto s = store_.view();
     par::parallel_for(s.n, [&](std::size_t i) {
       if (s.kind[i] != Kind::fluid) return;
@@ -125,8 +134,12 @@ StepInfo Simulation::step(double dt_cap) {
   }
   if (watch) {
     FailureReport report;
-    if (find_failure(store_, settings_.geometry, eos.rho0, settings_.watchdog, report) ||
+    if (find_failure(store_, settings_.geometry, eos.rho0, settings_.watchdog, report) || !step_error.empty() ||
         !(std::isfinite(dt) && dt > 0.0)) {
+      if (report.quantity.empty() && !step_error.empty()) {
+        report.quantity = "the step could not be completed (" + step_error + ")";
+        report.cause = "a time step too large for the forces, or an invalid state";
+      }
       if (report.quantity.empty()) {
         report.quantity = "the time step is not a positive finite number";
         report.cause = "an acceleration or velocity became NaN or Inf";

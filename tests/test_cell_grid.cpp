@@ -304,6 +304,18 @@ TEST(CellGrid, NeighboursEqualBruteForceForFarFlungSparsePoints) {
   EXPECT_EQ(nb, test::brute_force_neighbours<2>(pts.x, pts.h));
 }
 
+TEST(CellGrid, AParticleFlungBeyondTheIntegerRangeStillGivesAValidGrid) {
+  // Found by the scene fuzzer (UBSan): a particle at 1e25 m made the cell count per axis overflow an integer
+  // before the cells could grow. The grid must size itself in floating point and stay correct.
+  Points<2> pts = random_points<2>(300, 3.0, 0.5, 11);
+  pts.x.push_back(Vec<2>{1.1e25, -3.0e24});
+  pts.h.push_back(0.5);
+  CellGrid<2> grid;
+  const auto nb = grid_neighbours(pts, 1.0, &grid);
+  EXPECT_LE(grid.cell_count(), CellGrid<2>::cell_budget(pts.x.size()));
+  EXPECT_EQ(nb, test::brute_force_neighbours<2>(pts.x, pts.h));
+}
+
 TEST(CellGrid, NeighboursEqualBruteForceOnRandomPoints3D) {
   // ~30 neighbours per particle: density 1, support 2h = 1.9.
   const std::size_t n = scaled(12000);

@@ -19,6 +19,8 @@
 #include <vector>
 
 #include "core/case_builder.hpp"
+#include "core/scene/scene_builder.hpp"
+#include "core/scene/scene_parser.hpp"
 #include "core/io/hdf5_frames.hpp"
 #include "core/io/output_folder.hpp"
 #include "core/setup.hpp"
@@ -194,6 +196,29 @@ TEST(Watchdog, ParticleLeavingTheDomainIsCaught) {
       EXPECT_TRUE(geometry.in_fluid_domain(sim.store().x[i]));
     }
   }
+}
+
+TEST(Watchdog, ANonFinitePositionFromTheDriftIsAFailureNotAGridError) {
+  // Found by the scene fuzzer: gravity pointing up (+9.81) on a column with c0 = 2 m/s turns every position
+  // NaN within the first step, before the sweep. The grid refuses non-finite positions; the step must report
+  // that as the watchdog's failure (naming the particle, undone), not let the grid's error escape.
+  const std::string text = R"({
+    "name": "nan_in_one_step",
+    "container": { "lo": [0, 0], "hi": [50, 80], "open_top": true },
+    "fluid": [ { "shape": "rectangle", "lo": [0, 0], "hi": [25, 25], "spacing": 0.8333333333333334 } ],
+    "h_factor": 1.2,
+    "material": { "rho0": 1000, "c0": 2 },
+    "effects": {
+      "gravity": [0, 9.81],
+      "artificial_viscosity": { "alpha": 0.02, "beta": 0 },
+      "lennard_jones_wall": { "reference_height": 25, "r0_factor": 0.5 },
+      "ghost_walls": "free-slip"
+    },
+    "time": { "end": 4.0, "cfl": 0.2 }
+  })";
+  Simulation sim = scene::build_simulation(scene::scene_from_json(scene::parse_json_text(text, "nan.json")));
+  const FailureReport r = expect_failure(sim, FailureKind::not_finite, 5);
+  EXPECT_EQ(r.step, 1u);
 }
 
 TEST(Watchdog, RollbackLeavesARunnableSimulation) {
