@@ -7,7 +7,6 @@
 #include <utility>
 #include <vector>
 
-#include "parallel/compaction.hpp"
 
 namespace sph {
 
@@ -39,19 +38,10 @@ class Field {
   void resize(std::size_t n) { data_.resize(n, zero_value<T>()); }
   void reserve(std::size_t n) { data_.reserve(n); }
 
-  /// data := old data gathered through src (new[k] = old[src[k]]); src.size() is the new size.
-  void gather(const std::vector<std::uint32_t>& src) {
-    scratch_.resize(src.size());
-    par::gather(data_.data(), src.data(), src.size(), scratch_.data());
-    std::swap(data_, scratch_);
-  }
-
-  /// The three parts of gather(), for a store that gathers all its fields in one parallel region:
-  /// size the scratch (serial: it may allocate), fill it (from any thread), then swap it in.
-  T* gather_target(std::size_t m) {
-    scratch_.resize(m);
-    return scratch_.data();
-  }
+  /// A gather in three parts, so that the store gathers all its fields in one parallel region
+  /// (ParticleStore::gather): size the scratch (serial: it may allocate), fill it from any thread through
+  /// gather_scratch(), then swap it in with gather_commit().
+  void prepare_gather(std::size_t m) { scratch_.resize(m); }
   T* gather_scratch() { return scratch_.data(); }
   void gather_commit() { std::swap(data_, scratch_); }
 

@@ -116,7 +116,7 @@ class ParticleStore {
   /// region per field: a step gathers every field once, and each region costs a fork and a barrier.
   void gather(const std::vector<std::uint32_t>& src) {
     const std::size_t new_size = src.size();
-    for_each_field([&](auto& f) { (void)f.gather_target(new_size); });
+    for_each_field([&](auto& f) { f.prepare_gather(new_size); });
     const auto count = static_cast<std::ptrdiff_t>(new_size);
     const std::uint32_t* from = src.data();
 #pragma omp parallel

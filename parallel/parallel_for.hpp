@@ -43,7 +43,12 @@ inline std::size_t chunk_count(std::size_t n) { return (n + kChunk - 1) / kChunk
 template <class T, class Map, class Combine>
 T reduce(std::size_t n, T identity, Map&& map, Combine&& combine) {
   const std::size_t chunks = chunk_count(n);
-  std::vector<T> partial(chunks, identity);
+  // Per calling thread and per T, reused: a step reduces several times and should not allocate each time.
+  // (reduce is not re-entered with the same T from inside its own map.)
+  // The workers must see the calling thread's buffer: a lambda names a thread_local directly, not by capture.
+  thread_local std::vector<T> buffer;
+  std::vector<T>& partial = buffer;
+  partial.assign(chunks, identity);
   parallel_for_dynamic(chunks, 1, [&](std::size_t c) {
     T acc = identity;
     const std::size_t end = std::min(n, (c + 1) * kChunk);

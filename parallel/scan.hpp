@@ -12,7 +12,11 @@ namespace sph::par {
 template <class T>
 T exclusive_scan(const T* in, T* out, std::size_t n) {
   const std::size_t chunks = chunk_count(n);
-  std::vector<T> total(chunks + 1, T{});
+  // Per calling thread and T, reused: no allocation once sizes settle. Bound to a reference so that the
+  // workers' lambdas see the calling thread's buffer (a thread_local is not captured).
+  thread_local std::vector<T> buffer;
+  std::vector<T>& total = buffer;
+  total.assign(chunks + 1, T{});
   parallel_for(chunks, [&](std::size_t c) {
     T acc{};
     const std::size_t end = std::min(n, (c + 1) * kChunk);
