@@ -16,6 +16,16 @@ struct CubicSpline {
     return sigma / hd;
   }
 
+  /// The kernel's shape without its normalisation: W(r, h) = norm(h) * shape(r / h).
+  static double shape(double q) {
+    if (q < 1.0) return 1.0 - 1.5 * q * q + 0.75 * q * q * q;
+    if (q < 2.0) {
+      const double t = 2.0 - q;
+      return 0.25 * t * t * t;
+    }
+    return 0.0;
+  }
+
   /// W(r, h).
   static double value(double r, double h) {
     const double q = r / h;

@@ -1,9 +1,13 @@
 #pragma once
 // Picks the pair-sweep instantiation whose effect pack matches the enabled effects. The choice is made
-// once per run; the sweep is then one virtual call per step, never per pair.
+// once per run; the sweep is then one virtual call per step, never per pair. Each optional effect doubles
+// the instantiations: the pack is built one effect at a time, each step a compile-time branch.
 #include <memory>
+#include <string>
 #include <tuple>
+#include <utility>
 
+#include "core/effects/artificial_stress.hpp"
 #include "core/effects/artificial_viscosity.hpp"
 #include "core/effects/continuity.hpp"
 #include "core/effects/lennard_jones_wall.hpp"
@@ -17,42 +21,54 @@ class SweepBase {
  public:
   virtual ~SweepBase() = default;
   virtual SweepLimits run(ParticleView<2> s, const CellGrid<2>& grid) const = 0;
+  /// The effects in the pack, e.g. "continuity+pressure+viscosity|lj" (fluid pairs | wall pairs).
   virtual const char* name() const = 0;
 };
 
 template <class Fluid, class Wall>
 class SweepImpl final : public SweepBase {
  public:
-  SweepImpl(Fluid f, Wall w, double c0, Vec<2> g, const char* name) : sweep_(f, w, c0, g), name_(name) {}
+  SweepImpl(Fluid f, Wall w, double c0, Vec<2> g, std::string name)
+      : sweep_(std::move(f), std::move(w), c0, std::move(g)), name_(std::move(name)) {}
   SweepLimits run(ParticleView<2> s, const CellGrid<2>& grid) const override { return sweep_(s, grid); }
-  const char* name() const override { return name_; }
+  const char* name() const override { return name_.c_str(); }
 
  private:
   PairSweep<2, Fluid, Wall> sweep_;
-  const char* name_;
+  std::string name_;
 };
 
-inline std::unique_ptr<SweepBase> make_sweep(const SolverSettings& s) {
-  const double c0 = s.eos.c0;
+namespace sweep_detail {
+
+template <class Fluid>
+std::unique_ptr<SweepBase> with_walls(Fluid fluid, const SolverSettings& s, std::string name) {
   const Vec<2> g = s.gravity.value_or(Vec<2>::Zero());
+  if (s.lennard_jones) {
+    auto wall = std::make_tuple(LennardJonesWall{s.lennard_jones->strength, s.lennard_jones->r0_factor});
+    return std::make_unique<SweepImpl<Fluid, decltype(wall)>>(std::move(fluid), std::move(wall), s.eos.c0, g,
+                                                             name + "|lj");
+  }
+  return std::make_unique<SweepImpl<Fluid, std::tuple<>>>(std::move(fluid), std::tuple<>{}, s.eos.c0, g, name);
+}
+
+template <class Fluid>
+std::unique_ptr<SweepBase> with_stress(Fluid fluid, const SolverSettings& s, std::string name) {
+  if (s.artificial_stress) {
+    const ArtificialStress as{s.artificial_stress->epsilon, s.artificial_stress->exponent};
+    return with_walls(std::tuple_cat(std::move(fluid), std::make_tuple(as)), s, name + "+artificial_stress");
+  }
+  return with_walls(std::move(fluid), s, std::move(name));
+}
+
+}  // namespace sweep_detail
+
+inline std::unique_ptr<SweepBase> make_sweep(const SolverSettings& s) {
   const std::tuple<Continuity, PressureGradient> base{};
   if (s.viscosity) {
-    const ArtificialViscosity av{s.viscosity->alpha, s.viscosity->beta, c0};
-    const auto fluid = std::tuple_cat(base, std::make_tuple(av));
-    if (s.lennard_jones) {
-      const auto wall = std::make_tuple(LennardJonesWall{s.lennard_jones->strength, s.lennard_jones->r0_factor});
-      return std::make_unique<SweepImpl<decltype(fluid), decltype(wall)>>(fluid, wall, c0, g,
-                                                                          "continuity+pressure+viscosity|lj");
-    }
-    return std::make_unique<SweepImpl<decltype(fluid), std::tuple<>>>(fluid, std::tuple<>{}, c0, g,
-                                                                      "continuity+pressure+viscosity");
+    const ArtificialViscosity av{s.viscosity->alpha, s.viscosity->beta, s.eos.c0};
+    return sweep_detail::with_stress(std::tuple_cat(base, std::make_tuple(av)), s, "continuity+pressure+viscosity");
   }
-  if (s.lennard_jones) {
-    const auto wall = std::make_tuple(LennardJonesWall{s.lennard_jones->strength, s.lennard_jones->r0_factor});
-    return std::make_unique<SweepImpl<decltype(base), decltype(wall)>>(base, wall, c0, g, "continuity+pressure|lj");
-  }
-  return std::make_unique<SweepImpl<decltype(base), std::tuple<>>>(base, std::tuple<>{}, c0, g,
-                                                                   "continuity+pressure");
+  return sweep_detail::with_stress(base, s, "continuity+pressure");
 }
 
 }  // namespace sph

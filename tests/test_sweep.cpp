@@ -1,5 +1,6 @@
 // The pair sweep: pair forces are antisymmetric with mixed smoothing lengths (section 2.3), and the
-// sweep equals an independent O(N^2) evaluation of eqs. (5), (6), (9) and (10).
+// sweep equals an independent O(N^2) evaluation of eqs. (5), (6), (9) and (10), with and without the
+// optional artificial stress (Monaghan 2000).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -83,9 +84,11 @@ TEST(Sweep, InteractionRangeIsTwiceTheMeanSmoothingLength) {
 }
 
 TEST(Sweep, MixedLevelCloudHasZeroNetForceAndTorque) {
-  for (bool viscosity : {false, true}) {
+  for (int variant = 0; variant < 3; ++variant) {
+    const bool viscosity = variant > 0;
     SolverSettings st = isolated_settings(15.0, viscosity);
     if (st.viscosity) *st.viscosity = {0.5, 1.0};
+    if (variant == 2) st.artificial_stress = sph::ArtificialStressSettings{0.3, 4};
     ParticleStore<2> s = random_cloud(800, 10.0, 0.5, st.eos, 12345u, 2.0);
     run_sweep(s, st);
     Vec<2> net = Vec<2>::Zero();
@@ -156,6 +159,13 @@ Reference brute_force(const ParticleStore<2>& s, const SolverSettings& st) {
       if (st.viscosity && vij.dot(xij) < 0.0) {  // eq. (9), opposes approach
         const double rho_bar = 0.5 * (s.rho[i] + s.rho[j]);
         bracket += (-st.viscosity->alpha * c * mu + st.viscosity->beta * mu * mu) / rho_bar;
+      }
+      if (st.artificial_stress) {  // Monaghan (2000): R_ij (W(r, h_ij) / W(d_ij, h_ij))^n
+        const double eps = st.artificial_stress->epsilon;
+        const double Ri = s.p[i] < 0.0 ? -eps * s.p[i] / (s.rho[i] * s.rho[i]) : 0.0;
+        const double Rj = s.p[j] < 0.0 ? -eps * s.p[j] / (s.rho[j] * s.rho[j]) : 0.0;
+        const double f = K::value(r, hij) / K::value(0.5 * (s.d[i] + s.d[j]), hij);
+        bracket += (Ri + Rj) * std::pow(f, st.artificial_stress->exponent);
       }
       const Vec<2> f = -s.m[j] * bracket * gradW;
       ai += f;
@@ -264,6 +274,77 @@ TEST(Sweep, EqualsBruteForceWithLennardJonesWalls) {
     for (std::size_t i = 0; i < s.size(); ++i)
       if (with.a[i][1] - without.a[i][1] > 1e-6 * with.a_scale[i]) ++repelled;  // pushed up, away from y = 0
     EXPECT_GT(repelled, 20u);
+  }
+}
+
+TEST(Sweep, EqualsBruteForceWithArtificialStress) {
+  for (bool viscosity : {false, true}) {
+    SolverSettings st = twin_settings(viscosity, true);
+    st.artificial_stress = sph::ArtificialStressSettings{0.2, 4};
+    ParticleStore<2> s = twin_cloud(st, 11u);
+    std::size_t tension = 0;
+    for (std::size_t i = 0; i < s.size(); ++i) tension += s.kind[i] == Kind::fluid && s.p[i] < 0.0;
+    ASSERT_GT(tension, 100u);  // the cloud's densities straddle rho0
+    expect_matches_brute_force(s, st, viscosity ? "stress+viscosity+lj" : "stress+lj");
+    SolverSettings off = st;
+    off.artificial_stress.reset();
+    const Reference with = brute_force(s, st), without = brute_force(s, off);
+    std::size_t changed = 0;
+    for (std::size_t i = 0; i < s.size(); ++i)
+      if ((with.a[i] - without.a[i]).norm() > 1e-6 * with.a_scale[i]) ++changed;
+    EXPECT_GT(changed, 100u);
+  }
+}
+
+TEST(Sweep, ArtificialStressActsOnlyUnderTension) {
+  SolverSettings st = twin_settings(true, true);
+  ParticleStore<2> s = twin_cloud(st, 12u);
+  for (std::size_t i = 0; i < s.size(); ++i) {  // every particle at or above rho0: no negative pressure
+    s.rho[i] = st.eos.rho0 * (1.0 + 0.01 * static_cast<double>(i % 7) / 7.0);
+    s.p[i] = st.eos.pressure(s.rho[i]);
+  }
+  CellGrid<2> grid;
+  build_grid(s, grid);
+  sph::make_sweep(st)->run(s.view(), grid);
+  const std::vector<Vec<2>> a_off = s.a.values();
+  st.artificial_stress = sph::ArtificialStressSettings{0.2, 4};
+  const auto sweep = sph::make_sweep(st);
+  EXPECT_STREQ(sweep->name(), "continuity+pressure+viscosity+artificial_stress|lj");
+  sweep->run(s.view(), grid);
+  EXPECT_EQ(a_off, s.a.values());
+}
+
+TEST(Sweep, ArtificialStressPushesApartAPairThatTensionPullsTogether) {
+  // Two equal particles below rho0 (p < 0): the pressure term attracts them at every distance. With the
+  // artificial stress the pair repels at short range (eps f^n > 1, f = W(r)/W(d)) and still attracts at
+  // the lattice spacing (f = 1, eps < 1), so a stretched lattice is not pushed apart.
+  const double d = 0.5;
+  for (double r_over_d : {0.3, 1.0}) {
+    double along[2];
+    for (int with = 0; with < 2; ++with) {
+      SolverSettings st = isolated_settings(20.0, false);
+      if (with) st.artificial_stress = sph::ArtificialStressSettings{0.2, 4};
+      ParticleStore<2> s;
+      ParticleInit a, b;
+      a.rho = b.rho = 990.0;
+      a.m = b.m = 1000.0 * d * d;
+      a.h = b.h = 1.2 * d;
+      a.d = b.d = d;
+      b.x = Vec<2>(r_over_d * d, 0.0);
+      add_particle(s, a, st.eos);
+      add_particle(s, b, st.eos);
+      ASSERT_LT(s.p[0], 0.0);
+      run_sweep(s, st);
+      const std::size_t ia = s.x[0][0] < s.x[1][0] ? 0 : 1, ib = 1 - ia;
+      along[with] = s.a[ia].dot(s.x[ia] - s.x[ib]);  // > 0: pushed away from the other
+    }
+    EXPECT_LT(along[0], 0.0) << r_over_d;
+    if (r_over_d < 0.5) {
+      EXPECT_GT(along[1], 0.0) << r_over_d;
+    } else {
+      EXPECT_LT(along[1], 0.0) << r_over_d;
+      EXPECT_GT(along[1], along[0]) << r_over_d;
+    }
   }
 }
 

@@ -60,6 +60,13 @@ struct ArtificialViscosity {
   bool operator==(const ArtificialViscosity&) const = default;
 };
 
+/// Monaghan's artificial stress (optional, off by default): a repulsion between particles under tension.
+struct ArtificialStress {
+  double epsilon = 0.2;
+  int exponent = 4;
+  bool operator==(const ArtificialStress&) const = default;
+};
+
 /// Fixed wall particles with the Lennard-Jones repulsion, eq. (10). D given directly (strength) or as
 /// 5 g H from a reference height.
 struct LennardJonesWall {
@@ -97,6 +104,7 @@ struct StaticRefinement {
 struct Effects {
   std::optional<Vec<2>> gravity;
   std::optional<ArtificialViscosity> artificial_viscosity;
+  std::optional<ArtificialStress> artificial_stress;
   std::optional<LennardJonesWall> lennard_jones_wall;
   std::optional<Slip> ghost_walls;
   bool ghost_pressure_mirrored = false;  // ghost_pressure: "hydrostatic" (default) or "mirrored"

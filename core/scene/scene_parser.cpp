@@ -239,13 +239,17 @@ StaticRefinement parse_static_refinement(const Json& j, const std::string& path)
 
 Effects parse_effects(const Json& j, const std::string& path) {
   ObjectReader r(j, path,
-                 {"gravity", "artificial_viscosity", "lennard_jones_wall", "ghost_walls", "ghost_pressure", "refinement",
+                 {"gravity", "artificial_viscosity", "artificial_stress", "lennard_jones_wall", "ghost_walls", "ghost_pressure", "refinement",
                   "static_refinement"});
   Effects e;
   if (r.has("gravity")) e.gravity = r.vec2("gravity");
   if (r.has("artificial_viscosity")) {
     ObjectReader v(r.at("artificial_viscosity"), r.path("artificial_viscosity"), {"alpha", "beta"});
     e.artificial_viscosity = ArtificialViscosity{v.number("alpha", 0.02), v.number("beta", 0.0)};
+  }
+  if (r.has("artificial_stress")) {
+    ObjectReader a(r.at("artificial_stress"), r.path("artificial_stress"), {"epsilon", "exponent"});
+    e.artificial_stress = ArtificialStress{a.number("epsilon", 0.2), a.integer("exponent", 4)};
   }
   if (r.has("lennard_jones_wall")) {
     ObjectReader w(r.at("lennard_jones_wall"), r.path("lennard_jones_wall"),
@@ -767,6 +771,12 @@ void validate_scene(const Scene& s) {
     if (!(e.artificial_viscosity->alpha >= 0.0)) fail("effects.artificial_viscosity.alpha", "must not be negative");
     if (!(e.artificial_viscosity->beta >= 0.0)) fail("effects.artificial_viscosity.beta", "must not be negative");
   }
+  if (e.artificial_stress) {
+    const double eps = e.artificial_stress->epsilon;
+    if (!(eps > 0.0 && eps <= 1.0)) fail("effects.artificial_stress.epsilon", "must be in (0, 1] (got " + num(eps) + ")");
+    const int n = e.artificial_stress->exponent;
+    if (n < 1 || n > 16) fail("effects.artificial_stress.exponent", "must be between 1 and 16 (got " + std::to_string(n) + ")");
+  }
   if (e.refinement) {
     const Refinement& r = *e.refinement;
     const std::string p = "effects.refinement";
@@ -910,6 +920,9 @@ Json scene_to_json(const Scene& s) {
   if (fx.gravity) e["gravity"] = vec(*fx.gravity);
   if (fx.artificial_viscosity) {
     e["artificial_viscosity"] = Json{{"alpha", fx.artificial_viscosity->alpha}, {"beta", fx.artificial_viscosity->beta}};
+  }
+  if (fx.artificial_stress) {
+    e["artificial_stress"] = Json{{"epsilon", fx.artificial_stress->epsilon}, {"exponent", fx.artificial_stress->exponent}};
   }
   if (fx.lennard_jones_wall) {
     Json w;
