@@ -44,6 +44,7 @@ Simulation make_still_tank(const TankSpec& spec) {
   s.eos.c0 = spec.mach_factor * std::sqrt(kG * spec.depth);
   s.geometry.container = {Vec<2>(0, 0), Vec<2>(spec.width, 2.0 * spec.depth)};
   s.ghost_pressure = spec.ghost_pressure;
+  if (spec.density_diffusion) s.density_diffusion = DensityDiffusionSettings{0.1};
   if (spec.lennard_jones) s.lennard_jones = LennardJonesSettings{5.0 * kG * spec.depth, 0.5, spec.spacing / 2};
   Simulation sim(s);
   add_lattice(sim, lattice_rectangle(Vec<2>(0, 0), Vec<2>(spec.width, spec.depth), spec.spacing), spec.spacing,
@@ -79,7 +80,7 @@ Simulation make_drop(const DropSpec& spec) {
   SolverSettings s;
   s.eos.rho0 = 1000.0;
   s.eos.c0 = spec.mach_factor * std::sqrt(kG * spec.depth);
-  s.viscosity = ViscositySettings{spec.alpha, 0.0};
+  if (spec.density_diffusion) s.density_diffusion = DensityDiffusionSettings{0.1};
   const double half = 0.5 * spec.width;
   s.geometry.container = {Vec<2>(-half, 0), Vec<2>(half, 2.0 * spec.depth)};
   const double d = level_spacing(spec.spacing, spec.initial_level);

@@ -21,6 +21,10 @@ struct ArtificialStressSettings {
   int exponent = 4;      // n in f_ij^n
 };
 
+struct DensityDiffusionSettings {
+  double delta = 0.1;  // Molteni & Colagrossi (2009); 0.1 is the usual value
+};
+
 struct LennardJonesSettings {
   double strength = 1.0;   // D (PHYSICS.md default 5 g H_ref, set by the case)
   double r0_factor = 0.5;  // r0 = r0_factor d^{l_i}; 0.5 keeps it zero at rest with lattices d/2 off the wall
@@ -32,6 +36,7 @@ struct SolverSettings {
   std::optional<Vec<2>> gravity = Vec<2>(0.0, -9.81);
   std::optional<ViscositySettings> viscosity = ViscositySettings{};
   std::optional<ArtificialStressSettings> artificial_stress;  // off by default (PHYSICS.md: optional effect)
+  std::optional<DensityDiffusionSettings> density_diffusion;  // off by default (PHYSICS.md: optional effect)
   std::optional<LennardJonesSettings> lennard_jones;
   std::optional<GhostSlip> ghosts = GhostSlip::free_slip;
   GhostPressure ghost_pressure = GhostPressure::hydrostatic;

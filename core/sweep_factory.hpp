@@ -10,6 +10,7 @@
 #include "core/effects/artificial_stress.hpp"
 #include "core/effects/artificial_viscosity.hpp"
 #include "core/effects/continuity.hpp"
+#include "core/effects/density_diffusion.hpp"
 #include "core/effects/lennard_jones_wall.hpp"
 #include "core/effects/pressure_gradient.hpp"
 #include "core/solver_settings.hpp"
@@ -52,12 +53,23 @@ std::unique_ptr<SweepBase> with_walls(Fluid fluid, const SolverSettings& s, std:
 }
 
 template <class Fluid>
+std::unique_ptr<SweepBase> with_diffusion(Fluid fluid, const SolverSettings& s, std::string name) {
+  if (s.density_diffusion) {
+    const double c0 = s.eos.c0;
+    const Vec<2> g = s.gravity.value_or(Vec<2>::Zero());
+    const DensityDiffusion<2> dd{s.density_diffusion->delta, c0, (s.eos.rho0 / (c0 * c0)) * g};
+    return with_walls(std::tuple_cat(std::move(fluid), std::make_tuple(dd)), s, name + "+density_diffusion");
+  }
+  return with_walls(std::move(fluid), s, std::move(name));
+}
+
+template <class Fluid>
 std::unique_ptr<SweepBase> with_stress(Fluid fluid, const SolverSettings& s, std::string name) {
   if (s.artificial_stress) {
     const ArtificialStress as{s.artificial_stress->epsilon, s.artificial_stress->exponent};
-    return with_walls(std::tuple_cat(std::move(fluid), std::make_tuple(as)), s, name + "+artificial_stress");
+    return with_diffusion(std::tuple_cat(std::move(fluid), std::make_tuple(as)), s, name + "+artificial_stress");
   }
-  return with_walls(std::move(fluid), s, std::move(name));
+  return with_diffusion(std::move(fluid), s, std::move(name));
 }
 
 }  // namespace sweep_detail

@@ -30,6 +30,7 @@ Json full_scene() {
       "gravity": [0, -9.81],
       "artificial_viscosity": { "alpha": 0.05, "beta": 0.1 },
       "artificial_stress": { "epsilon": 0.3, "exponent": 3 },
+      "density_diffusion": { "delta": 0.12 },
       "lennard_jones_wall": { "reference_height": 5, "r0_factor": 0.5 },
       "ghost_walls": "no-slip",
       "refinement": { "criterion": "zone", "zone": { "lo": [0, 0], "hi": [3, 3] }, "pattern": "rsp", "rsp_k": 0.5,
@@ -69,6 +70,8 @@ TEST(SceneParser, FullSceneParsesWithEveryValue) {
   ASSERT_TRUE(s.effects.artificial_stress);
   EXPECT_EQ(s.effects.artificial_stress->epsilon, 0.3);
   EXPECT_EQ(s.effects.artificial_stress->exponent, 3);
+  ASSERT_TRUE(s.effects.density_diffusion);
+  EXPECT_EQ(s.effects.density_diffusion->delta, 0.12);
   ASSERT_TRUE(s.effects.refinement);
   EXPECT_EQ(s.effects.refinement->criterion, Criterion::zone);
   EXPECT_EQ(s.effects.refinement->pattern, Pattern::rsp);
@@ -113,6 +116,7 @@ TEST(SceneParser, AbsentEffectsStayAbsent) {
   EXPECT_FALSE(s.effects.gravity);
   EXPECT_FALSE(s.effects.artificial_viscosity);
   EXPECT_FALSE(s.effects.artificial_stress);
+  EXPECT_FALSE(s.effects.density_diffusion);
   EXPECT_FALSE(s.effects.lennard_jones_wall);
   EXPECT_FALSE(s.effects.ghost_walls);
   EXPECT_FALSE(s.effects.refinement);
@@ -188,6 +192,7 @@ TEST(SceneParser, NonPhysicalValuesAreRefused) {
       {"/effects/artificial_stress/epsilon", 0.0, "scene error: effects.artificial_stress.epsilon: must be in (0, 1] (got 0)"},
       {"/effects/artificial_stress/exponent", 0, "scene error: effects.artificial_stress.exponent: must be between 1 and 16 (got 0)"},
       {"/effects/artificial_stress/exponent", 2.5, "scene error: effects.artificial_stress.exponent: must be an integer (got a number)"},
+      {"/effects/density_diffusion/delta", -0.1, "scene error: effects.density_diffusion.delta: must be in (0, 1] (got -0.1)"},
       {"/effects/refinement/check_interval", 0, "scene error: effects.refinement.check_interval: must be at least 1 step"},
       {"/time/dt_max", 1e-12, "scene error: time.dt_max: would take more than 1e9 steps to reach time.end"},
       {"/time/output_interval", 0.0, "scene error: time.output_interval: must be positive (got 0)"},

@@ -67,6 +67,12 @@ struct ArtificialStress {
   bool operator==(const ArtificialStress&) const = default;
 };
 
+/// Density diffusion, delta-SPH with the hydrostatic correction (optional, off by default).
+struct DensityDiffusion {
+  double delta = 0.1;
+  bool operator==(const DensityDiffusion&) const = default;
+};
+
 /// Fixed wall particles with the Lennard-Jones repulsion, eq. (10). D given directly (strength) or as
 /// 5 g H from a reference height.
 struct LennardJonesWall {
@@ -105,6 +111,7 @@ struct Effects {
   std::optional<Vec<2>> gravity;
   std::optional<ArtificialViscosity> artificial_viscosity;
   std::optional<ArtificialStress> artificial_stress;
+  std::optional<DensityDiffusion> density_diffusion;
   std::optional<LennardJonesWall> lennard_jones_wall;
   std::optional<Slip> ghost_walls;
   bool ghost_pressure_mirrored = false;  // ghost_pressure: "hydrostatic" (default) or "mirrored"

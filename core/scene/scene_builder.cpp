@@ -42,6 +42,8 @@ SolverSettings solver_settings(const Scene& scene) {
   if (e.artificial_viscosity) s.viscosity = ViscositySettings{e.artificial_viscosity->alpha, e.artificial_viscosity->beta};
   s.artificial_stress.reset();
   if (e.artificial_stress) s.artificial_stress = ArtificialStressSettings{e.artificial_stress->epsilon, e.artificial_stress->exponent};
+  s.density_diffusion.reset();
+  if (e.density_diffusion) s.density_diffusion = DensityDiffusionSettings{e.density_diffusion->delta};
   s.lennard_jones.reset();
   if (e.lennard_jones_wall) {
     s.lennard_jones = LennardJonesSettings{lennard_jones_strength(scene), e.lennard_jones_wall->r0_factor, wall_spacing(scene)};

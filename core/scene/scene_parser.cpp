@@ -239,7 +239,7 @@ StaticRefinement parse_static_refinement(const Json& j, const std::string& path)
 
 Effects parse_effects(const Json& j, const std::string& path) {
   ObjectReader r(j, path,
-                 {"gravity", "artificial_viscosity", "artificial_stress", "lennard_jones_wall", "ghost_walls", "ghost_pressure", "refinement",
+                 {"gravity", "artificial_viscosity", "artificial_stress", "density_diffusion", "lennard_jones_wall", "ghost_walls", "ghost_pressure", "refinement",
                   "static_refinement"});
   Effects e;
   if (r.has("gravity")) e.gravity = r.vec2("gravity");
@@ -250,6 +250,10 @@ Effects parse_effects(const Json& j, const std::string& path) {
   if (r.has("artificial_stress")) {
     ObjectReader a(r.at("artificial_stress"), r.path("artificial_stress"), {"epsilon", "exponent"});
     e.artificial_stress = ArtificialStress{a.number("epsilon", 0.2), a.integer("exponent", 4)};
+  }
+  if (r.has("density_diffusion")) {
+    ObjectReader dd(r.at("density_diffusion"), r.path("density_diffusion"), {"delta"});
+    e.density_diffusion = DensityDiffusion{dd.number("delta", 0.1)};
   }
   if (r.has("lennard_jones_wall")) {
     ObjectReader w(r.at("lennard_jones_wall"), r.path("lennard_jones_wall"),
@@ -777,6 +781,10 @@ void validate_scene(const Scene& s) {
     const int n = e.artificial_stress->exponent;
     if (n < 1 || n > 16) fail("effects.artificial_stress.exponent", "must be between 1 and 16 (got " + std::to_string(n) + ")");
   }
+  if (e.density_diffusion) {
+    const double delta = e.density_diffusion->delta;
+    if (!(delta > 0.0 && delta <= 1.0)) fail("effects.density_diffusion.delta", "must be in (0, 1] (got " + num(delta) + ")");
+  }
   if (e.refinement) {
     const Refinement& r = *e.refinement;
     const std::string p = "effects.refinement";
@@ -924,6 +932,7 @@ Json scene_to_json(const Scene& s) {
   if (fx.artificial_stress) {
     e["artificial_stress"] = Json{{"epsilon", fx.artificial_stress->epsilon}, {"exponent", fx.artificial_stress->exponent}};
   }
+  if (fx.density_diffusion) e["density_diffusion"] = Json{{"delta", fx.density_diffusion->delta}};
   if (fx.lennard_jones_wall) {
     Json w;
     if (fx.lennard_jones_wall->strength) w["strength"] = *fx.lennard_jones_wall->strength;
