@@ -80,6 +80,7 @@ Simulation make_drop(const DropSpec& spec) {
   SolverSettings s;
   s.eos.rho0 = 1000.0;
   s.eos.c0 = spec.mach_factor * std::sqrt(kG * spec.depth);
+  s.viscosity = ViscositySettings{spec.alpha, 0.0};
   if (spec.density_diffusion) s.density_diffusion = DensityDiffusionSettings{0.1};
   const double half = 0.5 * spec.width;
   s.geometry.container = {Vec<2>(-half, 0), Vec<2>(half, 2.0 * spec.depth)};

@@ -45,6 +45,7 @@ struct DropSpec {
   double spacing = 25.0 / 30.0;
   double h_factor = 1.2;
   double mach_factor = 10.0;  // c0 = mach_factor * sqrt(g depth) (a few times the impact speed)
+  double alpha = 0.05;            // artificial viscosity (cases/drop.json says why not the default 0.02)
   bool density_diffusion = true;  // delta-SPH, delta = 0.1 (cases/drop.json says why)
   int initial_level = 0;
   bool fully_refined = false;
