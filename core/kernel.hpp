@@ -27,15 +27,7 @@ struct CubicSpline {
   }
 
   /// W(r, h).
-  static double value(double r, double h) {
-    const double q = r / h;
-    if (q < 1.0) return norm(h) * (1.0 - 1.5 * q * q + 0.75 * q * q * q);
-    if (q < 2.0) {
-      const double t = 2.0 - q;
-      return norm(h) * 0.25 * t * t * t;
-    }
-    return 0.0;
-  }
+  static double value(double r, double h) { return norm(h) * shape(r / h); }
 
   /// dW/dr(r, h); the gradient is dW/dr * x_ij / r_ij (zero at r = 0).
   static double derivative(double r, double h) {

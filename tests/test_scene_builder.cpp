@@ -38,7 +38,9 @@ void expect_same_settings(const SolverSettings& a, const SolverSettings& b) {
     EXPECT_EQ(a.viscosity->beta, b.viscosity->beta);
   }
   ASSERT_EQ(a.density_diffusion.has_value(), b.density_diffusion.has_value());
-  if (a.density_diffusion) EXPECT_EQ(a.density_diffusion->delta, b.density_diffusion->delta);
+  if (a.density_diffusion) {
+    EXPECT_EQ(a.density_diffusion->delta, b.density_diffusion->delta);
+  }
   ASSERT_EQ(a.artificial_stress.has_value(), b.artificial_stress.has_value());
   ASSERT_EQ(a.lennard_jones.has_value(), b.lennard_jones.has_value());
   if (a.lennard_jones) {
