@@ -21,7 +21,7 @@ ParticleStore<2> block_with_splash(bool splash) {
 }
 
 TEST(Probes, SurgeFrontAndWaterHeightIgnoreIsolatedSplashParticles) {
-  const double gap = 2.0;
+  const double gap = 1.0;  // one spacing of empty space between edges
   for (bool splash : {false, true}) {
     const ParticleStore<2> s = block_with_splash(splash);
     EXPECT_DOUBLE_EQ(scene::surge_front(s, 0.0, gap), 10.0) << "splash " << splash;
@@ -32,9 +32,40 @@ TEST(Probes, SurgeFrontAndWaterHeightIgnoreIsolatedSplashParticles) {
 TEST(Probes, ConnectedParticlesDoMoveTheFront) {
   ParticleStore<2> s = block_with_splash(false);
   FluidBlockSpec spec;
-  add_fluid(s, {Vec<2>(11.5, 0.5), Vec<2>(13.0, 0.5)}, spec, 1000.0);  // gaps of 1.5 spacings: connected
-  EXPECT_DOUBLE_EQ(scene::surge_front(s, 0.0, 2.0), 13.5);
-  EXPECT_DOUBLE_EQ(scene::water_height(s, 30.0, 1.0, 0.0, 2.0), 0.0);  // a dry column
+  spec.spacing = 1.0;
+  // Empty spaces of exactly one spacing, then half a spacing, between edges: connected.
+  add_fluid(s, {Vec<2>(11.5, 0.5), Vec<2>(13.0, 0.5)}, spec, 1000.0);
+  EXPECT_DOUBLE_EQ(scene::surge_front(s, 0.0, 1.0), 13.5);
+  EXPECT_DOUBLE_EQ(scene::water_height(s, 30.0, 1.0, 0.0, 1.0), 0.0);  // a dry column
+}
+
+// The gap is empty space between particle edges, so a droplet of fine particles and one of coarse particles
+// at the same distance from the body are treated alike (with centre distances the fine droplet, whose
+// centres sit closer to its edge, stayed connected across a wider gap: a refined run and a coarse one then
+// disagreed about when a falling drop joins the pool).
+TEST(Probes, GapIsMeasuredBetweenEdgesWhateverTheParticleSize) {
+  for (double empty : {0.9, 1.2}) {
+    for (double d : {1.0, 0.25}) {
+      ParticleStore<2> s = block_with_splash(false);  // spacing 1, top edge at y = 5, front edge at x = 10
+      FluidBlockSpec spec;
+      spec.spacing = d;
+      // A droplet of 2 x 2 particles of spacing d above the column at x ~ 0.5 (the probe's band) and one
+      // ahead of the front, each with its near edge `empty` away from the body.
+      std::vector<Vec<2>> drop;
+      for (int a = 0; a < 2; ++a) {
+        for (int b = 0; b < 2; ++b) {
+          drop.emplace_back(0.5 + (a - 0.5) * d, 5.0 + empty + (b + 0.5) * d);
+          drop.emplace_back(10.0 + empty + (a + 0.5) * d, 0.5 + (b - 0.5) * d);
+        }
+      }
+      add_fluid(s, drop, spec, 1000.0);
+      const bool joined = empty <= 1.0;
+      EXPECT_DOUBLE_EQ(scene::water_height(s, 0.5, 1.0, 0.0, 1.0), joined ? 5.0 + empty + 2 * d : 5.0)
+          << "empty " << empty << " d " << d;
+      EXPECT_DOUBLE_EQ(scene::surge_front(s, 0.0, 1.0), joined ? 10.0 + empty + 2 * d : 10.0)
+          << "empty " << empty << " d " << d;
+    }
+  }
 }
 
 }  // namespace

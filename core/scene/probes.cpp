@@ -12,21 +12,24 @@ namespace sph::scene {
 
 namespace {
 
-/// The end of the run of values that starts at the smallest one and has no gap wider than `gap`: the edge of
-/// the body of water, so that isolated splash particles beyond a gap do not move the probes.
+/// The end of the run of particles that starts at the smallest coordinate and has no empty space wider than
+/// `gap` between one particle's near edge (value - d/2) and the farthest edge reached so far (value + d/2):
+/// the edge of the body of water, so that isolated splash particles beyond a gap do not move the probes.
+/// Measured between edges, a gap is the same physical distance whatever the particles' sizes, so a refined
+/// run and a coarse one split the water at the same place.
 double contiguous_top(std::vector<std::pair<double, double>>& v, double gap) {
   if (v.empty()) return -std::numeric_limits<double>::infinity();
   std::sort(v.begin(), v.end());
   double top = v.front().first + v.front().second;
   for (std::size_t k = 1; k < v.size(); ++k) {
-    if (v[k].first - v[k - 1].first > gap) break;
+    if (v[k].first - v[k].second - top > gap) break;
     top = std::max(top, v[k].first + v[k].second);
   }
   return top;
 }
 
-/// The top y + d/2 of the water column |x_i - x| <= band connected to the bottom of the column (gaps of
-/// more than `gap` end it), or -infinity when the column is dry.
+/// The top y + d/2 of the water column |x_i - x| <= band connected to the bottom of the column (an empty
+/// space of more than `gap` ends it), or -infinity when the column is dry.
 double column_top(const ParticleStore<2>& store, double x, double band, double gap) {
   std::vector<std::pair<double, double>> ys;
   for (std::size_t i = 0; i < store.size(); ++i) {
@@ -67,7 +70,7 @@ double point_pressure(const ParticleStore<2>& store, const Vec<2>& point) {
 
 Probes::Probes(const Scene& scene) {
   const double band = coarsest_spacing(scene);
-  gap_ = 2.0 * band;
+  gap_ = band;
   for (const Probe& p : scene.probes) {
     Resolved r{p.kind, p.x, p.band.value_or(band), 0.0, p.position};
     switch (p.kind) {

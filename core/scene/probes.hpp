@@ -5,8 +5,9 @@
 //   surface_elevation  max(y_i + d_i/2) - datum over the same column (NaN when the column is dry)
 //   surge_front        Z = max(x_i + d_i/2) - origin over every fluid particle (the paper's Z(t))
 // Each maximum is taken over the body of water only: the values are sorted from the bottom (or from the
-// back wall) and the walk stops at the first gap wider than two coarse spacings, so a few isolated splash
-// particles ahead of the front or above the surface do not move the probes.
+// back wall) and the walk stops at the first empty space wider than one coarse spacing between a particle's
+// edge and the edge reached so far, so a few isolated splash particles ahead of the front or above the
+// surface do not move the probes (edges, not centres: the same gap at any particle size).
 //   pressure           Shepard-normalised SPH interpolation of p at a point over fluid and ghost particles,
 //                      sum_j V_j p_j W(r, h_j) / sum_j V_j W(r, h_j), V_j = m_j / rho_j (0 when no particle
 //                      reaches the point)
@@ -37,7 +38,7 @@ class Probes {
     Vec<2> position;
   };
   std::vector<Resolved> probes_;
-  double gap_ = 0.0;  // two coarse spacings: a wider gap separates splash from the body of water
+  double gap_ = 0.0;  // one coarse spacing: a wider empty space separates splash from the body of water
   std::vector<std::string> names_;
 };
 
