@@ -68,4 +68,36 @@ TEST(Probes, GapIsMeasuredBetweenEdgesWhateverTheParticleSize) {
   }
 }
 
+// A wave plunging over an air cavity: a layer at least two gaps thick above the gap counts (the gauge sees
+// its crest); a thin layer above a gap (splash) does not, wherever it lies. The surge front still ends at the
+// body of water.
+TEST(Probes, ColumnTopCountsThickLayersAboveAnAirCavityAndNotSplash) {
+  FluidBlockSpec spec;
+  spec.spacing = 1.0;
+  const double gap = 1.0;
+  for (double thickness : {1.0, 2.0, 3.0}) {
+    for (bool droplet_between : {false, true}) {
+      ParticleStore<2> s = block_with_splash(false);  // top edge at y = 5
+      // A layer from y = 9 (4 spacings of air) to 9 + thickness over x in [0, 2].
+      std::vector<Vec<2>> layer;
+      for (double y = 9.5; y < 9.0 + thickness; y += 1.0) {
+        layer.emplace_back(0.5, y);
+        layer.emplace_back(1.5, y);
+      }
+      add_fluid(s, layer, spec, 1000.0);
+      // A thin droplet in the cavity, 1.5 spacings of air above and below it, ignored either way.
+      if (droplet_between) add_fluid(s, {Vec<2>(0.5, 7.0)}, spec, 1000.0);
+      const double expected = thickness >= 2.0 * gap ? 9.0 + thickness : 5.0;
+      EXPECT_DOUBLE_EQ(scene::water_height(s, 0.5, 1.0, 0.0, gap), expected)
+          << "thickness " << thickness << " droplet " << droplet_between;
+    }
+  }
+  // A thick layer ahead of the front is not part of the body: the front stays at the body's edge.
+  ParticleStore<2> s = block_with_splash(false);
+  std::vector<Vec<2>> ahead;
+  for (double x = 13.5; x < 17.0; x += 1.0) ahead.emplace_back(x, 0.5);
+  add_fluid(s, ahead, spec, 1000.0);
+  EXPECT_DOUBLE_EQ(scene::surge_front(s, 0.0, gap), 10.0);
+}
+
 }  // namespace

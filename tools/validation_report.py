@@ -3,9 +3,11 @@
 then writes the probe CSVs, the figures (docs/figures/validation_*.png) and docs/VALIDATION.md.
 
     /usr/bin/python3 tools/validation_report.py [--quick] [--jobs 2] [--skip-runs] [--only CASE[,CASE]]
+                                                [--retime-short]
 
 Every run uses one OpenMP thread and two runs go side by side, so the wall times of the variants compare
-like with like. --quick drops the 16x resolution (the longest runs); --skip-runs reuses results/validation;
+like with like; a run shorter than 30 s is repeated and its best of three wall times kept (--retime-short
+reruns only those). --quick drops the 16x resolution (the longest runs); --skip-runs reuses results/validation;
 --only reruns the named cases (dam_break, drop, mm_column, lobovsky) and reuses the stored runs of the others.
 """
 import argparse
@@ -30,6 +32,8 @@ RESULTS = os.path.join(ROOT, "results", "validation")
 FIGURES = os.path.join(ROOT, "docs", "figures")
 DATA = os.path.join(ROOT, "tools", "data")
 G = 9.81
+SHORT_RUN_S = 30.0  # runs shorter than this (wall seconds) are repeated, and their best time kept
+REPEATS_SHORT = 3
 
 
 def read_csv(path):
@@ -79,18 +83,35 @@ def run_variant(job):
     cmd = [APP, "run", os.path.join(ROOT, scene), "-o", out, "--force", "-q", "--threads", "1"]
     for o in overrides:
         cmd += ["--set", o]
-    t0 = time.time()
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    if r.returncode != 0:
-        print(f"FAILED {case}/{name}: {r.stderr.strip()}", file=sys.stderr)
-        return job, None
-    print(f"  {case}/{name}: {time.time() - t0:.1f} s", flush=True)
+    walls = []
+    while True:
+        t0 = time.time()
+        r = subprocess.run(cmd, capture_output=True, text=True)
+        if r.returncode != 0:
+            print(f"FAILED {case}/{name}: {r.stderr.strip()}", file=sys.stderr)
+            return job, None
+        walls.append(load_run(out)[0]["wall_seconds"])
+        # A short run's wall time moves by 10-20 % with what runs beside it; the runs are deterministic, so a
+        # short one is run again and its best time kept (each repetition rewrites identical results).
+        if min(walls) >= SHORT_RUN_S or len(walls) == REPEATS_SHORT:
+            break
+    with open(os.path.join(out, "timings.json"), "w") as f:
+        json.dump({"wall_seconds": walls}, f)
+    print(f"  {case}/{name}: {time.time() - t0:.1f} s" + (f" (best of {len(walls)})" if len(walls) > 1 else ""),
+          flush=True)
     return job, out
 
 
 def load_run(out):
+    """run.json and series.csv of a run folder; wall_seconds is the best of the repetitions in timings.json."""
     with open(os.path.join(out, "run.json")) as f:
         summary = json.load(f)
+    timings = os.path.join(out, "timings.json")
+    if os.path.exists(timings):
+        with open(timings) as f:
+            walls = json.load(f)["wall_seconds"]
+        summary["wall_seconds_runs"] = walls
+        summary["wall_seconds"] = min(walls)
     series = read_csv(os.path.join(out, "series.csv"))
     return summary, series
 
@@ -105,6 +126,20 @@ def rms_between(t_a, a, t_b, b, t_max=None):
 
 def mean_count(series):
     return float(np.mean(series["fluid"])), int(series["fluid"][-1])
+
+
+def particle_steps(series):
+    """(fluid particle-steps over the run, the same if every level stepped at its own time step): each output
+    interval's steps times the particles of each level at its end. With one global step all particles take
+    the step of the finest level present; a level l particle could take 2^(finest - l) times longer steps
+    (dt scales with h, and h halves per level), so per-level stepping would count N_l / 2^(finest - l)."""
+    steps = np.diff(series["step"], prepend=0.0)
+    levels = sorted(int(k[6:]) for k in series if k.startswith("level_"))
+    counts = np.array([series[f"level_{l}"] for l in levels])  # levels x rows
+    finest = np.array([max((l for l, c in zip(levels, col) if c > 0), default=0) for col in counts.T])
+    total = float(np.sum(steps * counts.sum(axis=0)))
+    own = sum(np.sum(steps * counts[i] / 2.0 ** np.maximum(finest - l, 0)) for i, l in enumerate(levels))
+    return total, float(own)
 
 
 # ----------------------------------------------------------------------------------------------- figures
@@ -200,6 +235,9 @@ def summarise(case, runs, probe_norm, t_norm, t_max_star):
         row["status"] = ("stopped at t = %.3g s: %s" % (failure["time"], failure["quantity"])
                          if r["summary"].get("status") == "failed" and failure else "completed")
         row["rel_time"] = row["wall"] / ref["summary"]["wall_seconds"] if ref else float("nan")
+        ps, ps_own = particle_steps(s)
+        ref_ps = particle_steps(ref["series"])[0] if ref else float("nan")
+        row["rel_psteps"], row["rel_psteps_own"] = ps / ref_ps, ps_own / ref_ps
         for probe, norm in probe_norm.items():
             if ref is None:
                 row[f"rms_{probe}"] = float("nan")
@@ -237,10 +275,28 @@ def findings_section(f):
                 out.append(f"- {case} {pat.upper()} at {label}: {100 * r['rel_time']:.0f} % of the fully refined run's "
                            f"wall time (paper {100 * paper:.0f} %), {r['steps']} steps, RMS against the refined run "
                            f"{errs} ({'within' if ok else 'outside'} the 5 % target).")
-        out.append(f"- Why the {case} dynamic runs cost more than the paper's: one global time step (the first "
-                   "split halves it for every particle: ~1.8-2x the steps of a coarse-only run) and mixed-level "
-                   "pairs (a coarse particle next to fine ones has ~40 neighbours instead of ~18); docs/PERFORMANCE.md "
-                   "measures both. Mass drift is exactly 0 in every variant (refinement splits m into exact quarters).")
+        res = [row(rows, "aap" + tag) for tag in ("", "_x4", "_x16")]
+        if all(res):
+            lower = res[2]["rel_time"] < res[0]["rel_time"]
+            per_ps = [r["rel_time"] / r["rel_psteps"] for r in res]
+            out.append(f"- Why the {case} dynamic runs cost more than the paper's, measured: (1) one global time step. "
+                       "The first split sets the step of every particle to the fine one; AAP's particle-steps (mean "
+                       "fluid particles x steps, per level from series.csv) are "
+                       + ", ".join(f"{100 * r['rel_psteps']:.0f} %" for r in res)
+                       + " of the fully refined run's at 1x, 4x, 16x; if the coarse particles took their own, twice "
+                       "as long, step they would be "
+                       + ", ".join(f"{100 * r['rel_psteps_own']:.0f} %" for r in res)
+                       + " (an estimate from the counts: sphrefine has no per-level time stepping). (2) Mixed-level "
+                       "pairs: a coarse particle next to fine ones has ~40 neighbours instead of ~18, so a "
+                       "particle-step of the dynamic run costs "
+                       + ", ".join(f"{p:.2f}x" for p in per_ps)
+                       + " one of the refined run (docs/PERFORMANCE.md measures both). The time ratio is "
+                       f"{'lower' if lower else 'not lower'} at 16x than at the paper's counts "
+                       f"({100 * res[2]['rel_time']:.0f} % against {100 * res[0]['rel_time']:.0f} %; target: lower). "
+                       "The particle-step share does not fall with resolution: the velocity threshold is unchanged, "
+                       "so it marks the same region of the flow at every resolution; what can fall is the cost per "
+                       "particle-step, as the band of mixed-level pairs narrows relative to the refined region. "
+                       "Mass drift is exactly 0 in every variant (refinement splits m into exact quarters).")
     rows = f.get("mm_column")
     if rows:
         study = [row(rows, n) for n in ("refined_a15", "refined", "refined_a60")]
@@ -313,6 +369,8 @@ def main():
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--skip-runs", action="store_true")
     ap.add_argument("--only", default="", help="comma-separated cases to rerun; the others' stored runs are reused")
+    ap.add_argument("--retime-short", action="store_true",
+                    help=f"rerun only the stored variants shorter than {SHORT_RUN_S:g} s (best of {REPEATS_SHORT})")
     args = ap.parse_args()
     os.makedirs(FIGURES, exist_ok=True)
 
@@ -349,7 +407,13 @@ def main():
         unknown = only - {j[0] for j in jobs}
         if unknown:
             sys.exit(f"--only: unknown case(s) {', '.join(sorted(unknown))}")
-        order = sorted((j for j in jobs if not only or j[0] in only), key=lambda j: -j[4] * (2 if "refined" in j[2] else 1))
+        selected = [j for j in jobs if not only or j[0] in only]
+        if args.retime_short:
+            def stored_wall(j):
+                out = os.path.join(RESULTS, j[0], j[2])
+                return load_run(out)[0]["wall_seconds"] if os.path.exists(os.path.join(out, "run.json")) else 0.0
+            selected = [j for j in selected if stored_wall(j) < SHORT_RUN_S]
+        order = sorted(selected, key=lambda j: -j[4] * (2 if "refined" in j[2] else 1))
         print(f"running {len(order)} variants, {args.jobs} at a time, 1 thread each", flush=True)
         with ThreadPoolExecutor(max_workers=args.jobs) as pool:
             list(pool.map(run_variant, order))
@@ -368,13 +432,16 @@ def main():
     md.append("# Validation\n")
     md.append("Produced by `scripts/validate` (`tools/validation_report.py`) from the code as it is: every "
               "figure and table below is regenerated by that one command. Each run used one OpenMP thread, "
-              "two runs side by side on the 2-core machine, so wall times compare like with like.\n")
+              "two runs side by side on the 2-core machine, so wall times compare like with like; a run shorter than "
+              f"{SHORT_RUN_S:g} s is repeated and the best of its {REPEATS_SHORT} wall times kept (what runs beside "
+              "it moves a short run's time by 10-20 %).\n")
     md.append("Probe definitions (`core/scene/probes.cpp`): *H* is the top of the fluid column at the "
               "wall (highest `y + d/2` of the particles within one coarse spacing of `x`), *Z* the "
-              "surge front (largest `x + d/2`). Both are taken over the particles connected to the main "
-              "body: the walk from the bottom (or the back wall) stops at the first empty space wider than one "
-              "coarse spacing between particle edges (docs/SCENES.md), so a few isolated splash particles do not "
-              "move them, and a falling drop joins the pool at the same moment at every particle size.\n")
+              "surge front (largest `x + d/2`). Isolated splash particles do not move them: sorted from the "
+              "bottom (or the back wall), the particles fall into layers wherever more than one coarse spacing "
+              "of empty space separates particle edges; Z is the end of the first layer, and a column's top is "
+              "the highest top of a layer that is the lowest one or at least two coarse spacings thick, so a wave "
+              "plunging over an air cavity counts, as a wave gauge sees it (docs/SCENES.md).\n")
 
     # --- dam break
     if "dam_break" in runs:
@@ -416,6 +483,8 @@ def main():
         md.append(table(rows, [("variant", lambda r: r["name"]), ("wall s", lambda r: r["wall"]),
                                ("steps", lambda r: r["steps"]), ("mean N", lambda r: r["mean_n"]),
                                ("final N", lambda r: r["final_n"]), ("time / refined", lambda r: r["rel_time"]),
+                               ("particle-steps / refined", lambda r: r["rel_psteps"]),
+                               ("same, per-level steps (estimate)", lambda r: r["rel_psteps_own"]),
                                ("RMS H/H0 vs refined", lambda r: r["rms_H"]),
                                ("RMS Z/Z0 vs refined", lambda r: r["rms_Z"]),
                                ("mass drift", lambda r: r["mass_drift"]), ("status", lambda r: r["status"])]))
@@ -461,6 +530,8 @@ def main():
         md.append(table(rows, [("variant", lambda r: r["name"]), ("wall s", lambda r: r["wall"]),
                                ("steps", lambda r: r["steps"]), ("mean N", lambda r: r["mean_n"]),
                                ("final N", lambda r: r["final_n"]), ("time / refined", lambda r: r["rel_time"]),
+                               ("particle-steps / refined", lambda r: r["rel_psteps"]),
+                               ("same, per-level steps (estimate)", lambda r: r["rel_psteps_own"]),
                                ("RMS H/depth vs refined", lambda r: r["rms_H"]),
                                ("RMS H_left_wall/depth vs refined", lambda r: r["rms_H_left_wall"]),
                                ("mass drift", lambda r: r["mass_drift"]), ("status", lambda r: r["status"])]))

@@ -28,15 +28,36 @@ double contiguous_top(std::vector<std::pair<double, double>>& v, double gap) {
   return top;
 }
 
-/// The top y + d/2 of the water column |x_i - x| <= band connected to the bottom of the column (an empty
-/// space of more than `gap` ends it), or -infinity when the column is dry.
+/// The top y + d/2 of the water in the column |x_i - x| <= band, or -infinity when the column is dry. The
+/// column is cut into layers wherever more than `gap` of empty space separates a particle's bottom edge from
+/// the top edge reached so far. The lowest layer always counts; a layer above a gap counts when it is at least
+/// two gaps thick (top edge minus bottom edge), so a wave that plunges over an air cavity is measured at its
+/// crest, as a wave gauge sees it, while a few isolated splash particles above the surface are not.
 double column_top(const ParticleStore<2>& store, double x, double band, double gap) {
-  std::vector<std::pair<double, double>> ys;
+  std::vector<std::pair<double, double>> v;
   for (std::size_t i = 0; i < store.size(); ++i) {
     if (store.kind[i] != Kind::fluid || std::abs(store.x[i][0] - x) > band) continue;
-    ys.emplace_back(store.x[i][1], 0.5 * store.d[i]);
+    v.emplace_back(store.x[i][1], 0.5 * store.d[i]);
   }
-  return contiguous_top(ys, gap);
+  if (v.empty()) return -std::numeric_limits<double>::infinity();
+  std::sort(v.begin(), v.end());
+  const double thick = 2.0 * gap;
+  double bottom = v.front().first - v.front().second;
+  double top = v.front().first + v.front().second;
+  double result = top;
+  bool lowest = true;  // the lowest layer counts whatever its thickness
+  for (std::size_t k = 1; k < v.size(); ++k) {
+    const double lo = v[k].first - v[k].second;
+    if (lo - top > gap) {  // a new layer starts
+      lowest = false;
+      bottom = lo;
+      top = v[k].first + v[k].second;
+    } else {
+      top = std::max(top, v[k].first + v[k].second);
+    }
+    if (lowest || top - bottom >= thick) result = std::max(result, top);
+  }
+  return result;
 }
 
 }  // namespace

@@ -4,10 +4,12 @@
 //                      (the paper's H(t) at a wall; H = H0 at t = 0 for a lattice column)
 //   surface_elevation  max(y_i + d_i/2) - datum over the same column (NaN when the column is dry)
 //   surge_front        Z = max(x_i + d_i/2) - origin over every fluid particle (the paper's Z(t))
-// Each maximum is taken over the body of water only: the values are sorted from the bottom (or from the
-// back wall) and the walk stops at the first empty space wider than one coarse spacing between a particle's
-// edge and the edge reached so far, so a few isolated splash particles ahead of the front or above the
-// surface do not move the probes (edges, not centres: the same gap at any particle size).
+// Each maximum leaves isolated splash particles out. Sorted from the bottom (or from the back wall), the
+// particles fall into layers wherever more than one coarse spacing of empty space separates a particle's edge
+// from the edge reached so far (edges, not centres: the same gap at any particle size). The surge front is the
+// end of the first layer, the body of water. A column's top is the highest top of a layer that is the lowest
+// one or at least two coarse spacings thick: a wave plunging over an air cavity counts, as a wave gauge
+// sees it, and a few droplets above the surface do not.
 //   pressure           Shepard-normalised SPH interpolation of p at a point over fluid and ghost particles,
 //                      sum_j V_j p_j W(r, h_j) / sum_j V_j W(r, h_j), V_j = m_j / rho_j (0 when no particle
 //                      reaches the point)
