@@ -184,6 +184,8 @@ double lennard_jones_strength(const Scene& s);
 /// About how many particles the scene starts with: fluid (after a static refinement pass, which at most
 /// quadruples a region) and Lennard-Jones wall particles. What validation bounds, usable before building.
 double estimated_particles(const Scene& s);
+/// The lattice points of one fluid region at its lattice spacing (an upper estimate for a circle).
+double estimated_particles(const FluidRegion& f);
 /// The largest level-0 spacing of the fluid regions (default probe band).
 double coarsest_spacing(const Scene& s);
 

@@ -10,15 +10,18 @@
 #include <sstream>
 
 #include "core/particle_store.hpp"
+#include "core/scene/scene_rules.hpp"
 
 namespace sph::scene {
 
+using detail::element;
+using detail::fail;
+using detail::join;
+using detail::list;
+
 namespace {
 
-[[noreturn]] void fail(const std::string& path, const std::string& rule) { throw SceneError(path, rule); }
 
-std::string join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
-std::string element(const std::string& path, std::size_t i) { return path + "[" + std::to_string(i) + "]"; }
 
 const char* type_name(const Json& j) {
   switch (j.type()) {
@@ -48,11 +51,6 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
   return prev[b.size()];
 }
 
-std::string list(const std::vector<std::string>& names) {
-  std::string out;
-  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
-  return out;
-}
 
 /// Reads one JSON object: unknown keys are refused up front (with a suggestion), then typed accessors
 /// read keys with defaults or as required.
@@ -330,213 +328,7 @@ Output parse_output(const Json& j, const std::string& path) {
   return o;
 }
 
-// ---- value rules -------------------------------------------------------------------------------------------
-
-std::string num(double x) {
-  std::ostringstream s;
-  s.precision(6);
-  s << x;
-  return s.str();
-}
-
-void positive(double x, const std::string& path, const std::string& what = "must be positive") {
-  if (!(x > 0.0)) fail(path, what + " (got " + num(x) + ")");
-}
-
-void valid_rect(const Rect& r, const std::string& path) {
-  if (!(r.hi[0] > r.lo[0] && r.hi[1] > r.lo[1])) {
-    fail(join(path, "hi"), "must be greater than lo in x and in y (lo = [" + num(r.lo[0]) + ", " + num(r.lo[1]) +
-                               "], hi = [" + num(r.hi[0]) + ", " + num(r.hi[1]) + "])");
-  }
-}
-
-bool rects_overlap(const Rect& a, const Rect& b) {
-  return a.lo[0] < b.hi[0] && b.lo[0] < a.hi[0] && a.lo[1] < b.hi[1] && b.lo[1] < a.hi[1];
-}
-
-double distance_to_rect(const Vec<2>& p, const Rect& r) {
-  const double dx = std::max({r.lo[0] - p[0], 0.0, p[0] - r.hi[0]});
-  const double dy = std::max({r.lo[1] - p[1], 0.0, p[1] - r.hi[1]});
-  return std::hypot(dx, dy);
-}
-
-constexpr double kTol = 1e-9;
-constexpr int kMaxLevel = 8;
-constexpr double kMaxParticles = 5.0e7;
-
-bool inside(const Rect& inner, const Rect& outer) {
-  const double t = kTol * std::max(1.0, (outer.hi - outer.lo).cwiseAbs().maxCoeff());
-  return inner.lo[0] >= outer.lo[0] - t && inner.lo[1] >= outer.lo[1] - t && inner.hi[0] <= outer.hi[0] + t &&
-         inner.hi[1] <= outer.hi[1] + t;
-}
-
-Rect bounds(const FluidRegion& f) {
-  if (f.shape == Shape::rectangle) return f.rect;
-  return Rect{f.centre - Vec<2>::Constant(f.radius), f.centre + Vec<2>::Constant(f.radius)};
-}
-
-double estimated_particles(const FluidRegion& f) {
-  const double d = f.lattice_spacing();
-  if (f.shape == Shape::rectangle) {
-    return std::floor((f.rect.hi[0] - f.rect.lo[0]) / d + 1e-9) * std::floor((f.rect.hi[1] - f.rect.lo[1]) / d + 1e-9);
-  }
-  return std::numbers::pi * (f.radius / d + 1.0) * (f.radius / d + 1.0);
-}
-
-void validate_region(const Scene& s, const FluidRegion& f, const std::string& path) {
-  if (f.shape == Shape::rectangle) {
-    valid_rect(f.rect, path);
-  } else {
-    positive(f.radius, join(path, "radius"));
-  }
-  positive(f.spacing, join(path, "spacing"));
-  if (f.level < 0 || f.level > kMaxLevel) {
-    fail(join(path, "level"), "must be between 0 and " + std::to_string(kMaxLevel) + " (got " + std::to_string(f.level) + ")");
-  }
-  const double d = f.lattice_spacing();
-  if (!inside(bounds(f), s.container.box)) {
-    fail(path, std::string("the ") + to_string(f.shape) + " reaches outside the container");
-  }
-  for (std::size_t k = 0; k < s.obstacles.size(); ++k) {
-    const Rect& o = s.obstacles[k];
-    const bool overlap = f.shape == Shape::rectangle ? rects_overlap(f.rect, o)
-                                                     : distance_to_rect(f.centre, o) < f.radius - kTol;
-    if (overlap) fail(path, "overlaps obstacles[" + std::to_string(k) + "] (fluid must start outside every obstacle)");
-  }
-  const double n = estimated_particles(f);
-  if (f.shape == Shape::rectangle && n < 1.0) {
-    fail(join(path, "spacing"), "the rectangle holds no particle at lattice spacing " + num(d) + " m");
-  }
-  if (n > kMaxParticles) {
-    fail(join(path, "spacing"), "would create about " + num(n) + " particles (limit " + num(kMaxParticles) + ")");
-  }
-  if (f.hydrostatic) {
-    if (!s.effects.gravity) fail(join(path, "hydrostatic"), "needs effects.gravity");
-    if ((*s.effects.gravity)[0] != 0.0 || !((*s.effects.gravity)[1] < 0.0)) {
-      fail(join(path, "hydrostatic"), "needs gravity pointing along -y ([0, -g])");
-    }
-    if (f.shape == Shape::circle && !f.surface) fail(join(path, "surface"), "required for a hydrostatic circle");
-  } else if (f.surface) {
-    fail(join(path, "surface"), "only used with \"hydrostatic\": true");
-  }
-}
-
-void validate_probe(const Scene& s, const Probe& p, const std::string& path) {
-  const Rect& c = s.container.box;
-  if (p.kind == ProbeKind::water_height || p.kind == ProbeKind::surface_elevation) {
-    if (p.x < c.lo[0] - kTol || p.x > c.hi[0] + kTol) fail(join(path, "x"), "must lie within the container's x range");
-    if (p.band) positive(*p.band, join(path, "band"));
-  }
-  if (p.kind == ProbeKind::pressure && !inside(Rect{p.position, p.position}, c)) {
-    fail(join(path, "position"), "must lie inside the container");
-  }
-  if (p.name.empty()) fail(join(path, "name"), "must not be empty");
-  for (char ch : p.name) {
-    if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_')) {
-      fail(join(path, "name"), "may hold only letters, digits and '_' (it names a CSV column; got '" + p.name + "')");
-    }
-  }
-}
-
 }  // namespace
-
-// ---- derived quantities ---------------------------------------------------------------------------------------
-
-double FluidRegion::lattice_spacing() const { return spacing / std::pow(2.0, level); }
-
-double gravity_magnitude(const Scene& s) {
-  if (!s.effects.gravity) return 0.0;
-  const Vec<2>& g = *s.effects.gravity;
-  return g[0] == 0.0 ? std::abs(g[1]) : g.norm();
-}
-
-double sound_speed(const Scene& s) {
-  const Material& m = s.material;
-  if (m.c0) return *m.c0;
-  const double factor = m.mach_factor.value_or(10.0);
-  if (m.reference_speed) return factor * *m.reference_speed;
-  if (m.reference_height) return factor * std::sqrt(2.0 * gravity_magnitude(s) * *m.reference_height);
-  return 0.0;
-}
-
-namespace {
-int region_finest_level(const Scene& s, const FluidRegion& f) {
-  int l = f.level + (s.effects.static_refinement ? 1 : 0);
-  if (s.effects.refinement) l = std::max(l, s.effects.refinement->max_level);
-  return l;
-}
-}  // namespace
-
-int finest_level(const Scene& s) {
-  int l = 0;
-  for (const auto& f : s.fluid) l = std::max(l, region_finest_level(s, f));
-  return l;
-}
-
-double finest_spacing(const Scene& s) {
-  double d = std::numeric_limits<double>::infinity();
-  for (const auto& f : s.fluid) d = std::min(d, f.spacing / std::pow(2.0, region_finest_level(s, f)));
-  return d;
-}
-
-double coarsest_spacing(const Scene& s) {
-  double d = 0.0;
-  for (const auto& f : s.fluid) d = std::max(d, f.spacing);
-  return d;
-}
-
-double wall_spacing(const Scene& s) {
-  if (s.effects.lennard_jones_wall && s.effects.lennard_jones_wall->spacing) return *s.effects.lennard_jones_wall->spacing;
-  return finest_spacing(s) / 2;
-}
-
-double estimated_particles(const Scene& s) {
-  double fluid = 0.0;
-  for (const auto& f : s.fluid) fluid += estimated_particles(f);
-  if (s.effects.static_refinement) fluid *= 4.0;
-  double walls = 0.0;
-  if (s.effects.lennard_jones_wall) {
-    double extent = 2.0 * (s.container.box.hi - s.container.box.lo).sum();
-    for (const auto& o : s.obstacles) extent += 2.0 * (o.hi - o.lo).sum();
-    walls = extent / wall_spacing(s);
-  }
-  return fluid + walls;
-}
-
-double lennard_jones_strength(const Scene& s) {
-  if (!s.effects.lennard_jones_wall) return 0.0;
-  const LennardJonesWall& w = *s.effects.lennard_jones_wall;
-  if (w.strength) return *w.strength;
-  return 5.0 * gravity_magnitude(s) * w.reference_height.value_or(0.0);
-}
-
-const char* to_string(Shape v) { return v == Shape::rectangle ? "rectangle" : "circle"; }
-const char* to_string(Slip v) { return v == Slip::free_slip ? "free-slip" : "no-slip"; }
-const char* to_string(Criterion v) {
-  switch (v) {
-    case Criterion::velocity: return "velocity";
-    case Criterion::zone: return "zone";
-    case Criterion::few_neighbours: return "few_neighbours";
-  }
-  return "?";
-}
-const char* to_string(Pattern v) { return v == Pattern::aap ? "aap" : "rsp"; }
-const char* to_string(ProbeKind v) {
-  switch (v) {
-    case ProbeKind::water_height: return "water_height";
-    case ProbeKind::surge_front: return "surge_front";
-    case ProbeKind::surface_elevation: return "surface_elevation";
-    case ProbeKind::pressure: return "pressure";
-  }
-  return "?";
-}
-
-std::vector<std::string> particle_field_names() {
-  std::vector<std::string> names;
-  ParticleStore<2> store;
-  store.for_each_field([&](const auto& f) { names.emplace_back(f.name()); });
-  return names;
-}
 
 // ---- JSON text ------------------------------------------------------------------------------------------------
 
@@ -728,157 +520,6 @@ Scene scene_from_json(const Json& doc) {
   if (r.has("output")) s.output = parse_output(r.at("output"), "output");
   validate_scene(s);
   return s;
-}
-
-void validate_scene(const Scene& s) {
-  if (s.name.empty()) fail("name", "must not be empty");
-  for (char ch : s.name) {
-    if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-' || ch == '.')) {
-      fail("name", "may hold only letters, digits, '_', '-' and '.' (it names the output folder; got '" + s.name + "')");
-    }
-  }
-  valid_rect(s.container.box, "container");
-  for (std::size_t k = 0; k < s.obstacles.size(); ++k) {
-    const std::string path = element("obstacles", k);
-    valid_rect(s.obstacles[k], path);
-    if (!inside(s.obstacles[k], s.container.box)) fail(path, "must lie inside the container");
-  }
-
-  // Material and effects come first: the regions' rules (hydrostatic) depend on gravity.
-  const Material& m = s.material;
-  positive(m.rho0, "material.rho0");
-  if (!(m.gamma >= 1.0)) fail("material.gamma", "must be at least 1 (got " + num(m.gamma) + ")");
-  if (m.c0) {
-    positive(*m.c0, "material.c0");
-    if (m.mach_factor || m.reference_speed || m.reference_height) {
-      fail("material", "give either c0, or mach_factor with reference_speed or reference_height, not both");
-    }
-  } else {
-    if (m.mach_factor) positive(*m.mach_factor, "material.mach_factor");
-    if (m.reference_speed && m.reference_height) {
-      fail("material", "give reference_speed or reference_height, not both");
-    }
-    if (m.reference_speed) {
-      positive(*m.reference_speed, "material.reference_speed");
-    } else if (m.reference_height) {
-      positive(*m.reference_height, "material.reference_height");
-      if (gravity_magnitude(s) <= 0.0) fail("material.reference_height", "needs effects.gravity (v_ref = sqrt(2 g H))");
-    } else {
-      fail("material.c0", "missing required key (or give mach_factor with reference_speed or reference_height)");
-    }
-  }
-  if (!(s.h_factor >= 0.5 && s.h_factor <= 3.0)) fail("h_factor", "must be between 0.5 and 3 (got " + num(s.h_factor) + ")");
-
-  const Effects& e = s.effects;
-  if (e.gravity && !(e.gravity->norm() > 0.0)) fail("effects.gravity", "must not be zero (remove the key to turn gravity off)");
-  if (e.artificial_viscosity) {
-    if (!(e.artificial_viscosity->alpha >= 0.0)) fail("effects.artificial_viscosity.alpha", "must not be negative");
-    if (!(e.artificial_viscosity->beta >= 0.0)) fail("effects.artificial_viscosity.beta", "must not be negative");
-  }
-  if (e.artificial_stress) {
-    const double eps = e.artificial_stress->epsilon;
-    if (!(eps > 0.0 && eps <= 1.0)) fail("effects.artificial_stress.epsilon", "must be in (0, 1] (got " + num(eps) + ")");
-    const int n = e.artificial_stress->exponent;
-    if (n < 1 || n > 16) fail("effects.artificial_stress.exponent", "must be between 1 and 16 (got " + std::to_string(n) + ")");
-  }
-  if (e.density_diffusion) {
-    const double delta = e.density_diffusion->delta;
-    if (!(delta > 0.0 && delta <= 1.0)) fail("effects.density_diffusion.delta", "must be in (0, 1] (got " + num(delta) + ")");
-  }
-  if (e.refinement) {
-    const Refinement& r = *e.refinement;
-    const std::string p = "effects.refinement";
-    if (r.criterion == Criterion::velocity) positive(r.v_threshold, p + ".v_threshold");
-    if (r.criterion == Criterion::zone) valid_rect(r.zone, p + ".zone");
-    if (r.criterion == Criterion::few_neighbours && r.min_neighbours < 1) fail(p + ".min_neighbours", "must be at least 1");
-    if (!(r.rsp_k > 0.0 && r.rsp_k <= 2.0)) fail(p + ".rsp_k", "must be in (0, 2] (got " + num(r.rsp_k) + ")");
-    if (r.check_interval < 1) fail(p + ".check_interval", "must be at least 1 step");
-    if (r.max_level < 1 || r.max_level > kMaxLevel) {
-      fail(p + ".max_level", "must be between 1 and " + std::to_string(kMaxLevel) + " (got " + std::to_string(r.max_level) + ")");
-    }
-  }
-  if (e.static_refinement) {
-    if (e.static_refinement->box) valid_rect(*e.static_refinement->box, "effects.static_refinement.box");
-    const double k = e.static_refinement->rsp_k;
-    if (!(k > 0.0 && k <= 2.0)) fail("effects.static_refinement.rsp_k", "must be in (0, 2] (got " + num(k) + ")");
-  }
-
-  if (s.fluid.empty()) fail("fluid", "at least one fluid region is required");
-  double total = 0.0;
-  for (std::size_t k = 0; k < s.fluid.size(); ++k) {
-    validate_region(s, s.fluid[k], element("fluid", k));
-    total += estimated_particles(s.fluid[k]);
-  }
-  if (total > kMaxParticles) fail("fluid", "the regions would create about " + num(total) + " particles (limit " + num(kMaxParticles) + ")");
-
-  if (e.refinement) {
-    int start = 0;
-    for (const auto& f : s.fluid) start = std::max(start, f.level + (e.static_refinement ? 1 : 0));
-    if (e.refinement->max_level <= start) {
-      fail("effects.refinement.max_level",
-           "must exceed the particles' starting level " + std::to_string(start) + ", or nothing is ever refined");
-    }
-  }
-  if (e.lennard_jones_wall) {
-    const LennardJonesWall& w = *e.lennard_jones_wall;
-    const std::string p = "effects.lennard_jones_wall";
-    if (w.strength && w.reference_height) fail(p, "give strength or reference_height, not both");
-    if (w.strength) {
-      positive(*w.strength, p + ".strength");
-    } else if (w.reference_height) {
-      positive(*w.reference_height, p + ".reference_height");
-      if (gravity_magnitude(s) <= 0.0) fail(p + ".reference_height", "needs effects.gravity (D = 5 g H)");
-    } else {
-      fail(p + ".strength", "missing required key (or give reference_height, D = 5 g H)");
-    }
-    if (!(w.r0_factor > 0.0 && w.r0_factor <= 2.0)) fail(p + ".r0_factor", "must be in (0, 2] (got " + num(w.r0_factor) + ")");
-    if (w.spacing) positive(*w.spacing, p + ".spacing");
-    // Resolution rule: at the finest level the scene can reach (spacing d), the repulsion range r0 =
-    // r0_factor d must cover the wall-particle spacing, or particles of that level slip between them.
-    const double d = finest_spacing(s);
-    const double r0 = w.r0_factor * d;
-    const double ws = wall_spacing(s);
-    if (ws > r0 * (1.0 + 1e-9)) {
-      // With an explicit spacing, a coarser finest level (max_level) or a finer wall spacing fixes it; with the
-      // default spacing (d_min / 2) only r0_factor can be at fault.
-      fail(w.spacing ? p + ".spacing" : p + ".r0_factor",
-           "the walls cannot resolve level " + std::to_string(finest_level(s)) + ": wall-particle spacing " + num(ws) +
-               " m exceeds the repulsion range r0 = r0_factor * d = " + num(r0) + " m of its particles (d = " + num(d) +
-               (w.spacing ? " m); lower the refinement level or the wall spacing" : " m); raise r0_factor to 0.5 or more"));
-    }
-    double extent = 2.0 * (s.container.box.hi - s.container.box.lo).sum();
-    for (const auto& o : s.obstacles) extent += 2.0 * (o.hi - o.lo).sum();
-    if (extent / ws > kMaxParticles) fail(p + ".spacing", "would create more than " + num(kMaxParticles) + " wall particles");
-  }
-
-  const Time& t = s.time;
-  positive(t.end, "time.end");
-  if (!(t.cfl > 0.0 && t.cfl <= 1.0)) fail("time.cfl", "must be in (0, 1] (got " + num(t.cfl) + ")");
-  positive(t.dt_max, "time.dt_max");
-  if (t.end / t.dt_max > 1e9) fail("time.dt_max", "would take more than 1e9 steps to reach time.end");
-  if (t.output_interval) {
-    positive(*t.output_interval, "time.output_interval");
-    if (t.end / *t.output_interval > 1e6) fail("time.output_interval", "would write more than a million outputs");
-  }
-
-  for (std::size_t k = 0; k < s.probes.size(); ++k) {
-    validate_probe(s, s.probes[k], element("probes", k));
-    for (std::size_t j = 0; j < k; ++j) {
-      if (s.probes[j].name == s.probes[k].name) fail(element("probes", k) + ".name", "duplicate probe name '" + s.probes[k].name + "'");
-    }
-  }
-
-  const Output& o = s.output;
-  if (o.frame_interval) {
-    positive(*o.frame_interval, "output.frame_interval");
-    if (t.end / *o.frame_interval > 1e6) fail("output.frame_interval", "would write more than a million frames");
-  }
-  const auto names = particle_field_names();
-  for (std::size_t k = 0; k < o.fields.size(); ++k) {
-    if (std::find(names.begin(), names.end(), o.fields[k]) == names.end()) {
-      fail(element("output.fields", k), "unknown field '" + o.fields[k] + "'; fields: " + list(names));
-    }
-  }
 }
 
 Scene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
