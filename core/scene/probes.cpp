@@ -12,52 +12,45 @@ namespace sph::scene {
 
 namespace {
 
-/// The end of the run of particles that starts at the smallest coordinate and has no empty space wider than
-/// `gap` between one particle's near edge (value - d/2) and the farthest edge reached so far (value + d/2):
-/// the edge of the body of water, so that isolated splash particles beyond a gap do not move the probes.
-/// Measured between edges, a gap is the same physical distance whatever the particles' sizes, so a refined
-/// run and a coarse one split the water at the same place.
-double contiguous_top(std::vector<std::pair<double, double>>& v, double gap) {
+/// The top edge of the water along one axis: `v` holds (coordinate, d/2) per particle. Sorted from the smallest
+/// coordinate, the particles fall into layers wherever more than `gap` of empty space separates a particle's
+/// near edge (value - d/2) from the farthest edge reached so far (value + d/2). Measured between edges, a gap
+/// is the same physical distance whatever the particles' sizes, so a refined run and a coarse one split the
+/// water at the same place. The result is the highest top of a layer that is the first one or at least
+/// `thick` deep (top edge minus bottom edge); with thick = infinity, the end of the first layer, the body of
+/// water. -infinity when `v` is empty.
+double layered_top(std::vector<std::pair<double, double>>& v, double gap, double thick) {
   if (v.empty()) return -std::numeric_limits<double>::infinity();
   std::sort(v.begin(), v.end());
+  double bottom = v.front().first - v.front().second;
   double top = v.front().first + v.front().second;
+  double result = top;
+  bool first = true;  // the first layer counts whatever its thickness
   for (std::size_t k = 1; k < v.size(); ++k) {
-    if (v[k].first - v[k].second - top > gap) break;
-    top = std::max(top, v[k].first + v[k].second);
+    const double lo = v[k].first - v[k].second;
+    if (lo - top > gap) {  // a new layer starts
+      first = false;
+      bottom = lo;
+      top = v[k].first + v[k].second;
+    } else {
+      top = std::max(top, v[k].first + v[k].second);
+    }
+    if (first || top - bottom >= thick) result = std::max(result, top);
   }
-  return top;
+  return result;
 }
 
-/// The top y + d/2 of the water in the column |x_i - x| <= band, or -infinity when the column is dry. The
-/// column is cut into layers wherever more than `gap` of empty space separates a particle's bottom edge from
-/// the top edge reached so far. The lowest layer always counts; a layer above a gap counts when it is at least
-/// two gaps thick (top edge minus bottom edge), so a wave that plunges over an air cavity is measured at its
-/// crest, as a wave gauge sees it, while a few isolated splash particles above the surface are not.
+/// The top y + d/2 of the water in the column |x_i - x| <= band, or -infinity when the column is dry: a
+/// layer above a gap counts when it is at least two gaps thick, so a wave that plunges over an air cavity is
+/// measured at its crest, as a wave gauge sees it, while a few isolated splash particles above the surface are
+/// not.
 double column_top(const ParticleStore<2>& store, double x, double band, double gap) {
   std::vector<std::pair<double, double>> v;
   for (std::size_t i = 0; i < store.size(); ++i) {
     if (store.kind[i] != Kind::fluid || std::abs(store.x[i][0] - x) > band) continue;
     v.emplace_back(store.x[i][1], 0.5 * store.d[i]);
   }
-  if (v.empty()) return -std::numeric_limits<double>::infinity();
-  std::sort(v.begin(), v.end());
-  const double thick = 2.0 * gap;
-  double bottom = v.front().first - v.front().second;
-  double top = v.front().first + v.front().second;
-  double result = top;
-  bool lowest = true;  // the lowest layer counts whatever its thickness
-  for (std::size_t k = 1; k < v.size(); ++k) {
-    const double lo = v[k].first - v[k].second;
-    if (lo - top > gap) {  // a new layer starts
-      lowest = false;
-      bottom = lo;
-      top = v[k].first + v[k].second;
-    } else {
-      top = std::max(top, v[k].first + v[k].second);
-    }
-    if (lowest || top - bottom >= thick) result = std::max(result, top);
-  }
-  return result;
+  return layered_top(v, gap, 2.0 * gap);
 }
 
 }  // namespace
@@ -72,7 +65,7 @@ double surge_front(const ParticleStore<2>& store, double origin, double gap) {
   for (std::size_t i = 0; i < store.size(); ++i) {
     if (store.kind[i] == Kind::fluid) xs.emplace_back(store.x[i][0], 0.5 * store.d[i]);
   }
-  const double front = contiguous_top(xs, gap);
+  const double front = layered_top(xs, gap, std::numeric_limits<double>::infinity());
   return std::isfinite(front) ? front - origin : 0.0;
 }
 
