@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -87,6 +88,7 @@ int run_command(const RunArguments& args) {
   options.folder = folder;
   if (!args.resume.empty()) options.resume = args.resume;
   if (args.checkpoint_every > 0.0) options.checkpoint_interval = args.checkpoint_every;
+  options.threads_from_work = args.threads <= 0;  // --threads fixes the count; otherwise it follows the work
   ProgressPrinter progress(stdout, args.quiet);
   try {
     scene::Runner runner(s, options);
@@ -143,6 +145,8 @@ int info_command() {
   H5get_libversion(&h5_major, &h5_minor, &h5_release);
   std::printf("sphrefine %s (%s build)\n", SPH_VERSION, SPH_BUILD_TYPE);
   std::printf("  OpenMP      %d (max threads %d, processors %d)\n", _OPENMP, omp_get_max_threads(), omp_get_num_procs());
+  const char* policy = std::getenv("OMP_WAIT_POLICY");
+  std::printf("  wait policy %s\n", policy ? policy : "the runtime's default (GOMP_SPINCOUNT or KMP_BLOCKTIME set)");
   std::printf("  Eigen       %d.%d.%d\n", EIGEN_WORLD_VERSION, EIGEN_MAJOR_VERSION, EIGEN_MINOR_VERSION);
   std::printf("  HDF5        %u.%u.%u\n", h5_major, h5_minor, h5_release);
   std::printf("  nlohmann    %d.%d.%d\n", NLOHMANN_JSON_VERSION_MAJOR, NLOHMANN_JSON_VERSION_MINOR, NLOHMANN_JSON_VERSION_PATCH);

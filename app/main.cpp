@@ -6,8 +6,10 @@
 #include <CLI/CLI.hpp>
 
 #include "app/commands.hpp"
+#include "app/wait_policy.hpp"
 
 int main(int argc, char** argv) {
+  sph::app::ensure_wait_policy(argv);  // may start the program again, before anything else happens
   CLI::App app{"sphrefine: weakly-compressible SPH with dynamic particle refinement"};
   app.require_subcommand(1);
 

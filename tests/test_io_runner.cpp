@@ -142,6 +142,38 @@ TEST(Runner, ResumedRunIsBitwiseIdenticalToTheUninterruptedOne) {
   EXPECT_FALSE(has_temporary_files(c_dir));
 }
 
+// A finished run extended with a later time.end (--resume --set time.end=...) is the run that went to the
+// later end without stopping, bitwise, at 1 and 2 threads. The first run's last step is shortened to land on
+// its end (0.043 s falls between steps), which the longer run never does.
+TEST(Runner, AFinishedRunExtendedToALaterEndIsTheUninterruptedRun) {
+  const int saved = omp_get_max_threads();
+  for (const int threads : {1, 2}) {
+    SCOPED_TRACE(threads);
+    omp_set_num_threads(threads);
+    TempFolder tmp;
+    scene::Scene shorter = tiny_scene();
+    shorter.time.end = 0.043;
+    const scene::Scene longer = tiny_scene();  // end 0.08
+    const fs::path a_dir = tmp.path() / "a", b_dir = tmp.path() / "b";
+    scene::Runner a(longer, scene::RunOptions{a_dir, std::nullopt, 0.02});
+    a.run();
+
+    {
+      scene::Runner b(shorter, scene::RunOptions{b_dir, std::nullopt, 0.02});
+      b.run();
+      EXPECT_EQ(b.simulation().time(), 0.043) << "the last step lands on the end time";
+    }
+    scene::Runner extended(longer, scene::RunOptions{b_dir, b_dir / "checkpoint.h5", 0.02});
+    EXPECT_LT(extended.simulation().time(), 0.043) << "the checkpoint precedes the shortened step";
+    extended.run();
+    EXPECT_EQ(extended.simulation().step_count(), a.simulation().step_count());
+    EXPECT_EQ(extended.simulation().time(), a.simulation().time());
+    expect_bitwise_equal(extended.simulation().store(), a.simulation().store());
+    EXPECT_EQ(lines(b_dir / "series.csv"), lines(a_dir / "series.csv"));
+  }
+  omp_set_num_threads(saved);
+}
+
 TEST(Runner, ResumeRefusesACheckpointOfAnotherScene) {
   TempFolder tmp;
   scene::Scene s = tiny_scene();

@@ -17,6 +17,7 @@
 #include "parallel/counting_sort.hpp"
 #include "parallel/parallel_for.hpp"
 #include "parallel/scan.hpp"
+#include "parallel/threads.hpp"
 
 namespace sph {
 namespace {
@@ -326,3 +327,13 @@ TEST(Parallel, FloatingPointSumDiffersFromNaiveOrderSoTheTestIsMeaningful) {
 
 }  // namespace
 }  // namespace sph
+
+// The default thread count: one thread per kMinItemsPerThread items, at least one, at most what is offered.
+TEST(Parallel, ThreadsForTheWorkFollowTheRule) {
+  EXPECT_EQ(sph::par::threads_for(0, 8), 1);
+  EXPECT_EQ(sph::par::threads_for(900, 2), 1);  // the paper's dam break
+  EXPECT_EQ(sph::par::threads_for(2 * sph::par::kMinItemsPerThread - 1, 8), 1);
+  EXPECT_EQ(sph::par::threads_for(2 * sph::par::kMinItemsPerThread, 8), 2);
+  EXPECT_EQ(sph::par::threads_for(1000000, 2), 2);
+  EXPECT_EQ(sph::par::threads_for(1000000, 0), 1);  // nothing offered: still one
+}

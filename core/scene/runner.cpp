@@ -13,6 +13,7 @@
 #include "core/io/time_series.hpp"
 #include "core/scene/scene_builder.hpp"
 #include "core/scene/scene_parser.hpp"
+#include "parallel/threads.hpp"
 
 namespace sph::scene {
 
@@ -82,6 +83,14 @@ Runner::Runner(Scene scene, RunOptions options)
     initial_mass_ = d.mass;
     initial_momentum_ = d.momentum;
   }
+  if (options_.threads_from_work) {
+    thread_limit_ = omp_get_max_threads();
+    fit_threads(fluid_count());
+  }
+}
+
+void Runner::fit_threads(std::size_t fluid) {
+  if (thread_limit_ > 0) omp_set_num_threads(par::threads_for(fluid, thread_limit_));
 }
 
 Runner::~Runner() = default;
@@ -137,8 +146,16 @@ void Runner::start() {
 void Runner::advance() {
   if (!started_) start();
   const double t0 = sim_.time();
+  const double remaining = scene_.time.end - t0;
+  if (sim_.dt() > remaining && options_.checkpoint_interval) {
+    // The last step is shortened to land on the end time, which an uninterrupted longer run never does. The
+    // checkpoint that ends this run is the state before that step, so that a run extended from it (--resume
+    // with a later time.end) is bitwise the uninterrupted one; resumed with the same end, it replays this step.
+    write_checkpoint();
+    final_step_shortened_ = true;
+  }
   try {
-    sim_.step(scene_.time.end - sim_.time());
+    sim_.step(remaining);
   } catch (const SimulationFailure& f) {
     fail(f.report());  // the simulation is back at the last good state
   }
@@ -155,7 +172,9 @@ void Runner::advance() {
                              " s; try a smaller time.cfl, a larger sound speed or more viscosity");
   }
   ++steps_run_;
-  last_fluid_ = fluid_count();
+  const std::size_t fluid = fluid_count();
+  if (fluid != last_fluid_) fit_threads(fluid);
+  last_fluid_ = fluid;
   particle_steps_ += last_fluid_;
   write_due_outputs(false);
 }
@@ -173,7 +192,7 @@ void Runner::write_due_outputs(bool final) {
     write_frame();
     next_frame_ = next_index(t, frame_interval(scene_));
   }
-  if (options_.checkpoint_interval) {
+  if (options_.checkpoint_interval && !final_step_shortened_) {
     const double ci = *options_.checkpoint_interval;
     if (final ? last_checkpoint_step_ != step : due(t, next_checkpoint_, ci)) {
       next_checkpoint_ = next_index(t, ci);
@@ -254,6 +273,9 @@ void Runner::write_summary(const RunSummary& r, const FailureReport* failure) {
   j["version"] = SPH_VERSION;
   j["build_type"] = SPH_BUILD_TYPE;
   j["threads"] = omp_get_max_threads();
+  j["threads_rule"] = thread_limit_ > 0 ? "one per " + std::to_string(par::kMinItemsPerThread) +
+                                              " fluid particles, at most " + std::to_string(thread_limit_)
+                                        : std::string("as set");
   j["sweep"] = sim_.sweep_name();
   j["resumed"] = resumed_;
   j["status"] = failure ? "failed" : "completed";

@@ -32,7 +32,14 @@ namespace sph::scene {
 struct RunOptions {
   std::filesystem::path folder;                 // output folder; empty: the run writes nothing
   std::optional<std::filesystem::path> resume;  // continue from this checkpoint
-  std::optional<double> checkpoint_interval;    // simulated seconds between checkpoints (and one at the end)
+  std::optional<double> checkpoint_interval;    // simulated seconds between checkpoints (and one at the end:
+                                                // the state before the last step if that step was shortened
+                                                // to land on the end time, so that an extended run continues
+                                                // the uninterrupted one)
+  /// false: OpenMP's thread count is left as the caller set it. true: the runner picks it from the fluid
+  /// count (par::threads_for, parallel/threads.hpp) whenever the count changes, up to the threads OpenMP
+  /// offers when the runner is made. Results are the same either way; only speed differs.
+  bool threads_from_work = false;
 };
 
 struct Progress {
@@ -105,6 +112,7 @@ class Runner {
   void write_summary(const RunSummary& r, const FailureReport* failure);
   [[noreturn]] void fail(const FailureReport& report);
   std::size_t fluid_count() const;
+  void fit_threads(std::size_t fluid);
 
   Scene scene_;
   RunOptions options_;
@@ -117,9 +125,11 @@ class Runner {
   std::uint64_t last_row_step_ = UINT64_MAX, last_frame_step_ = UINT64_MAX, last_checkpoint_step_ = UINT64_MAX;
   std::uint64_t particle_steps_ = 0, steps_run_ = 0, rows_ = 0, frames_written_ = 0, checkpoints_ = 0;
   std::size_t last_fluid_ = 0;  // fluid particles after the last step
+  int thread_limit_ = 0;        // threads_from_work: the most threads the runner may use
   double initial_mass_ = 0.0;
   Vec<2> initial_momentum_ = Vec<2>::Zero();
   bool resumed_ = false;
+  bool final_step_shortened_ = false;  // the checkpoint holds the state before the shortened last step
   bool started_ = false;
   double wall_start_ = 0.0;
 };
