@@ -7,11 +7,8 @@
 // order (cells in lexicographic order, particles in store order): deterministic at any thread count.
 //
 // The cell size is free: a query scans the cells that overlap the square [x_i - R_i, x_i + R_i]^D with
-// R_i = h_i + max_h, each row of cells along x as one contiguous run. Cells sized by the finest support (not
-// the largest) keep a fine particle among coarse ones from scanning coarse-sized cells: with mixed levels the
-// scanned area follows each particle's own reach (a level-1 particle among level-0 ones scans 16 h0^2
-// instead of 36 h0^2). Smaller cells (h) would trim a uniform set's scan from 36 h^2 to 25 h^2 but measured
-// 3 % faster at 1e5 particles and 40 % slower at 1e6 (4x the cells to sort), so the solver uses 2 h_min.
+// R_i = h_i + max_h, each row of cells along x as one contiguous run. The solver's choice, and why, is in
+// core/neighbour_cells.hpp.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -39,11 +36,33 @@ class CellGrid {
     return std::min(kMaxCells, std::max<std::size_t>(std::size_t{1} << 16, 16 * n));
   }
 
+  /// A bounding box; a non-finite point makes it infinite (a NaN would vanish in min/max), which build()
+  /// refuses.
+  struct Box {
+    VecD lo = VecD::Constant(std::numeric_limits<double>::infinity());
+    VecD hi = VecD::Constant(-std::numeric_limits<double>::infinity());
+    static Box of(const VecD& p) {
+      if (p.allFinite()) return Box{p, p};
+      const double inf = std::numeric_limits<double>::infinity();
+      return Box{VecD::Constant(-inf), VecD::Constant(inf)};
+    }
+    Box merged(const Box& o) const { return Box{lo.cwiseMin(o.lo), hi.cwiseMax(o.hi)}; }
+  };
+
   /// Sorts particles into cells of size >= `min_cell_size`. `max_h` is the largest smoothing length of
   /// the particles (a query around particle i reaches h_i + max_h); by default min_cell_size / 2, the
   /// classic cell = support. After this call, the store must be gathered through order() before cell ranges
   /// refer to it.
   void build(const VecD* x, std::size_t n, double min_cell_size, double max_h = -1.0) {
+    const Box box = par::reduce(
+        n, Box{}, [&](std::size_t i) { return Box::of(x[i]); },
+        [](const Box& a, const Box& b) { return a.merged(b); });
+    build_in(box, x, n, min_cell_size, max_h);
+  }
+
+  /// build() with the particles' bounding box already known (Box::of merged over x[0..n)): a caller that
+  /// writes the positions in a loop of its own reduces the box there, saving a parallel region.
+  void build_in(Box box, const VecD* x, std::size_t n, double min_cell_size, double max_h = -1.0) {
     if (!(min_cell_size > 0.0) || !std::isfinite(min_cell_size)) {
       throw std::invalid_argument("CellGrid::build: cell size must be positive and finite");
     }
@@ -51,18 +70,6 @@ class CellGrid {
     if (!std::isfinite(max_h)) throw std::invalid_argument("CellGrid::build: max_h must be finite");
     max_h_ = max_h;
     n_ = n;
-    struct Box {
-      VecD lo, hi;
-    };
-    const double inf = std::numeric_limits<double>::infinity();
-    Box init{VecD::Constant(inf), VecD::Constant(-inf)};
-    Box box = par::reduce(
-        n, init,
-        // A NaN would vanish in min/max: any non-finite position maps to an infinite box, caught below.
-        [&](std::size_t i) {
-          return x[i].allFinite() ? Box{x[i], x[i]} : Box{VecD::Constant(-inf), VecD::Constant(inf)};
-        },
-        [](const Box& a, const Box& b) { return Box{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)}; });
     if (n == 0) box = Box{VecD::Zero(), VecD::Zero()};
     for (int k = 0; k < D; ++k) {
       if (!std::isfinite(box.lo[k]) || !std::isfinite(box.hi[k])) {

@@ -110,43 +110,48 @@ class ParticleStore {
     return first;
   }
 
-  /// Every field := old field gathered through src (new[k] = old[src[k]]). The one primitive behind
-  /// permutation (src a permutation), compaction (src increasing) and expansion (src repeats indices).
+  /// Every field := old field gathered through src (new[k] = old[src(k)] for k < new_size). The one
+  /// primitive behind permutation (src a permutation), compaction (src increasing) and expansion (src
+  /// repeats indices); src may compose maps (it is evaluated once per field and item, and must be pure).
   /// All fields in one parallel region (a worksharing loop per field, no barrier between them), not one
-  /// region per field: a step gathers every field once, and each region costs a fork and a barrier.
-  void gather(const std::vector<std::uint32_t>& src) {
-    const std::size_t new_size = src.size();
+  /// region per field: a step gathers every field once, and each region costs a fork and a join.
+  template <class Src>
+  void gather(std::size_t new_size, Src&& src) {
     for_each_field([&](auto& f) { f.prepare_gather(new_size); });
     const auto count = static_cast<std::ptrdiff_t>(new_size);
-    const std::uint32_t* from = src.data();
 #pragma omp parallel
     {
       for_each_field([&](auto& f) {
         auto* out = f.gather_scratch();
         const auto* in = f.data();
 #pragma omp for schedule(static) nowait
-        for (std::ptrdiff_t k = 0; k < count; ++k) out[k] = in[from[k]];
+        for (std::ptrdiff_t k = 0; k < count; ++k) out[k] = in[src(static_cast<std::size_t>(k))];
       });
     }
     for_each_field([&](auto& f) { f.gather_commit(); });
   }
+  void gather(const std::vector<std::uint32_t>& src) {
+    const std::uint32_t* from = src.data();
+    gather(src.size(), [from](std::size_t k) { return from[k]; });
+  }
 
-  /// This store := a copy of `other`'s particles (values and next id; the scratch buffers are not copied),
-  /// every field in one parallel region. Reuses this store's capacity: no allocation once sizes settle.
-  void assign_from(const ParticleStore& other) {
+  /// Sizes this store as `other` (and takes its next id) for copy_particle(); no allocation once sizes settle.
+  void prepare_copy_of(const ParticleStore& other) {
     const std::size_t n = other.size();
     for_each_field([n](auto& f) { f.values().resize(n); });
-    const auto count = static_cast<std::ptrdiff_t>(n);
-#pragma omp parallel
-    {
-      for_each_field_with(other, [&](auto& mine, const auto& theirs) {
-        auto* out = mine.data();
-        const auto* in = theirs.data();
-#pragma omp for schedule(static) nowait
-        for (std::ptrdiff_t k = 0; k < count; ++k) out[k] = in[k];
-      });
-    }
     next_id_ = other.next_id_;
+  }
+  /// Particle i := other's particle i, every field. After prepare_copy_of(other); safe from any thread for
+  /// distinct i, so a copy can ride in another loop over the particles instead of a region of its own.
+  void copy_particle(const ParticleStore& other, std::size_t i) {
+    for_each_field_with(other, [i](auto& mine, const auto& theirs) { mine[i] = theirs[i]; });
+  }
+
+  /// This store := a copy of `other`'s particles (values and next id; the scratch buffers are not copied).
+  /// Reuses this store's capacity: no allocation once sizes settle.
+  void assign_from(const ParticleStore& other) {
+    prepare_copy_of(other);
+    par::parallel_for(other.size(), [&](std::size_t i) { copy_particle(other, i); });
   }
 
   /// Keeps the particles with keep(i), in order.

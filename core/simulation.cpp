@@ -5,6 +5,7 @@
 #include <limits>
 #include <string>
 
+#include "core/neighbour_cells.hpp"
 #include "parallel/parallel_for.hpp"
 
 namespace sph {
@@ -17,61 +18,69 @@ Simulation::Simulation(SolverSettings settings) : settings_(std::move(settings))
   sweep_ = make_sweep(settings_);
 }
 
+std::uint32_t Simulation::output_count(const ParticleView<2>& view, std::size_t i) const {
+  if (ghosts_) return ghosts_->output_count(view, i);
+  return view.kind[i] == Kind::ghost ? 0u : 1u;
+}
+
 void Simulation::prepare_neighbours() {
   const auto view = store_.view();
+  expand_offsets_.resize(view.n + 1);
+  const SmoothingRange hr = par::reduce(
+      view.n, SmoothingRange{},
+      [&](std::size_t i) {
+        expand_offsets_[i] = output_count(view, i);
+        return SmoothingRange::of(view.kind[i], view.h[i]);
+      },
+      [](const SmoothingRange& a, const SmoothingRange& b) { return a.merged(b); });
+  build_neighbours(hr);
+}
+
+void Simulation::build_neighbours(const SmoothingRange& hr) {
+  // Parallel regions here: the scan of the output counts, the expansion (with the bounding box of what it
+  // writes), the cell sort, the gather of every field, the ghosts' own values. expand_offsets_[0..n) holds
+  // each particle's output count (ghosts 0, walls 1, fluid 1 + its images), written by the caller's loop.
+  const auto view = store_.view();
   const std::size_t n = view.n;
-  // 1. The expansion: each particle's outputs (ghosts 0, walls 1, fluid 1 + its images).
-  expand_offsets_.resize(n + 1);
-  if (ghosts_) {
-    par::parallel_for(n, [&](std::size_t i) { expand_offsets_[i] = ghosts_->output_count(view, i); });
-  } else {
-    par::parallel_for(n, [&](std::size_t i) { expand_offsets_[i] = 1; });
-  }
   expand_offsets_[n] = par::exclusive_scan(expand_offsets_.data(), expand_offsets_.data(), n);
   const std::size_t m = expand_offsets_[n];
   expand_src_.resize(m);
   expand_image_.resize(m);
   expand_x_.resize(m);
-  par::parallel_for(n, [&](std::size_t i) {
-    const std::uint32_t first = expand_offsets_[i], count = expand_offsets_[i + 1] - first;
-    if (count == 0) return;
-    expand_src_[first] = static_cast<std::uint32_t>(i);
-    expand_image_[first] = -1;
-    expand_x_[first] = view.x[i];
-    if (count == 1) return;
-    const GhostBuilder::Images im = ghosts_->images(view.x[i], view.v[i], view.h[i]);
-    for (std::uint32_t g = 1; g < count; ++g) {
-      expand_src_[first + g] = static_cast<std::uint32_t>(i);
-      expand_image_[first + g] = static_cast<std::int8_t>(g - 1);
-      expand_x_[first + g] = im.x[g - 1];
-    }
-  });
-  // 2. The cell sort of the expanded set, composed with the expansion into one source map.
-  // Cells as wide as the finest support present (2 h_min); each particle's query reaches h_i + h_max
-  // (CellGrid). A uniform set gets the classic support-sized cells.
-  const auto h = view.h;
-  struct Range {
-    double lo, hi;
-  };
-  const double inf = std::numeric_limits<double>::infinity();
-  const Range hr = par::reduce(
-      n, Range{inf, 0.0},
-      [&](std::size_t i) { return view.kind[i] == Kind::ghost ? Range{inf, 0.0} : Range{h[i], h[i]}; },
-      [](const Range& a, const Range& b) { return Range{std::min(a.lo, b.lo), std::max(a.hi, b.hi)}; });
-  grid_.build(expand_x_.data(), m, std::max(2.0 * std::min(hr.lo, hr.hi), 1e-12), hr.hi);
-  const auto& order = grid_.order();
-  gather_src_.resize(m);
-  gather_image_.resize(m);
-  par::parallel_for(m, [&](std::size_t k) {
-    gather_src_[k] = expand_src_[order[k]];
-    gather_image_[k] = expand_image_[order[k]];
-  });
-  // 3. One gather of every field, then the copies that are ghosts become ghosts.
-  store_.gather(gather_src_);
+  using Box = CellGrid<2>::Box;
+  const Box box = par::reduce(
+      n, Box{},
+      [&](std::size_t i) {
+        const std::uint32_t first = expand_offsets_[i], count = expand_offsets_[i + 1] - first;
+        Box b;
+        if (count == 0) return b;
+        expand_src_[first] = static_cast<std::uint32_t>(i);
+        expand_image_[first] = -1;
+        expand_x_[first] = view.x[i];
+        b = Box::of(view.x[i]);
+        if (count == 1) return b;
+        const GhostBuilder::Images im = ghosts_->images(view.x[i], view.v[i], view.h[i]);
+        for (std::uint32_t g = 1; g < count; ++g) {
+          expand_src_[first + g] = static_cast<std::uint32_t>(i);
+          expand_image_[first + g] = static_cast<std::int8_t>(g - 1);
+          expand_x_[first + g] = im.x[g - 1];
+          b = b.merged(Box::of(im.x[g - 1]));
+        }
+        return b;
+      },
+      [](const Box& a, const Box& b) { return a.merged(b); });
+  // The cell sort of the expanded set, composed with the expansion into one source map. Cells sized by the
+  // finest support present (core/neighbour_cells.hpp); each particle's query reaches h_i + h_max.
+  grid_.build_in(box, expand_x_.data(), m, neighbour_cell_size(hr), hr.max);
+  const std::uint32_t* order = grid_.order().data();
+  const std::uint32_t* src = expand_src_.data();
+  // One gather of every field, then the copies that are ghosts become ghosts.
+  store_.gather(m, [order, src](std::size_t k) { return src[order[k]]; });
   if (ghosts_) {
     auto s = store_.view();
     par::parallel_for(m, [&](std::size_t k) {
-      if (gather_image_[k] >= 0) ghosts_->make_ghost(s, k, gather_image_[k]);
+      const std::int8_t image = expand_image_[order[k]];
+      if (image >= 0) ghosts_->make_ghost(s, k, image);
     });
   }
 }
@@ -95,29 +104,40 @@ double Simulation::next_dt() const {
 StepInfo Simulation::step(double dt_cap) {
   const double dt = std::min(dt_, dt_cap);
   const bool watch = settings_.watchdog.enabled;
-  if (watch) {
-    last_good_.assign_from(store_);  // reuses capacity: no allocation once the sizes are stable
-    last_good_limits_ = limits_;
-  }
   const double half = 0.5 * dt;
   const TaitEquationOfState eos = settings_.eos;
+  std::string step_error;
+  // One parallel region for the rollback copy, the kick and drift, and the first pass of the neighbour
+  // preparation (each particle's output count and the smoothing-length range): all per particle.
+  if (watch) {
+    last_good_.prepare_copy_of(store_);  // reuses capacity: no allocation once the sizes are stable
+    last_good_limits_ = limits_;
+  }
+  SmoothingRange hr;
   {
     auto s = store_.view();
-    par::parallel_for(s.n, [&](std::size_t i) {
-      if (s.kind[i] != Kind::fluid) return;
-      s.vh[i] = s.v[i] + half * s.a[i];
-      s.rhoh[i] = s.rho[i] + half * s.drho[i];
-      s.x[i] += dt * s.vh[i];
-      s.v[i] = s.vh[i] + half * s.a[i];
-      s.rho[i] = s.rhoh[i] + half * s.drho[i];
-      s.p[i] = eos.pressure(s.rho[i]);
-    });
+    expand_offsets_.resize(s.n + 1);
+    hr = par::reduce(
+        s.n, SmoothingRange{},
+        [&](std::size_t i) {
+          if (watch) last_good_.copy_particle(store_, i);
+          if (s.kind[i] == Kind::fluid) {
+            s.vh[i] = s.v[i] + half * s.a[i];
+            s.rhoh[i] = s.rho[i] + half * s.drho[i];
+            s.x[i] += dt * s.vh[i];
+            s.v[i] = s.vh[i] + half * s.a[i];
+            s.rho[i] = s.rhoh[i] + half * s.drho[i];
+            s.p[i] = eos.pressure(s.rho[i]);
+          }
+          expand_offsets_[i] = output_count(s, i);
+          return SmoothingRange::of(s.kind[i], s.h[i]);
+        },
+        [](const SmoothingRange& a, const SmoothingRange& b) { return a.merged(b); });
   }
   // The drift can already have produced a non-finite position, which the grid refuses: with the watchdog on,
   // that is reported (and undone) like any other failure of the step, naming the particle.
-  std::string step_error;
   try {
-    prepare_neighbours();
+    build_neighbours(hr);
     limits_ = sweep_->run(store_.view(), grid_);
   } catch (const std::exception& e) {
     if (!watch) throw;

@@ -8,6 +8,12 @@
 //   forces at x_{n+1} with the predicted v = v_h + dt/2 a_n and rho = rho_h + dt/2 drho_n,
 //   v_{n+1} = v_h + dt/2 a_{n+1},  rho_{n+1} = rho_h + dt/2 drho_{n+1}.
 // With central pair forces this conserves linear and angular momentum to rounding.
+//
+// Parallel regions per step (each a fork and a join, and on busy cores each can cost a scheduler time slice):
+// 1. the watchdog's copy, kick and drift, output counts and h range (one loop); 2. the scan of the counts;
+// 3. the expansion with its bounding box; 4. the cell sort (one region, its phases separated by barriers);
+// 5. the gather of every field through the composed map; 6. the ghosts' values; 7. the pair sweep; 8. the
+// closing kick; 9. the watchdog's scan. There were 19.
 #include <memory>
 #include <optional>
 #include <vector>
@@ -15,6 +21,7 @@
 #include "core/boundary/ghosts.hpp"
 #include "core/cell_grid.hpp"
 #include "core/diagnostics.hpp"
+#include "core/neighbour_cells.hpp"
 #include "core/particle_store.hpp"
 #include "core/solver_settings.hpp"
 #include "core/sweep_factory.hpp"
@@ -87,6 +94,11 @@ class Simulation {
 
  private:
   double next_dt() const;
+  /// How many entries particle i has in the expanded set: ghosts 0, walls 1, fluid 1 + its images.
+  std::uint32_t output_count(const ParticleView<2>& view, std::size_t i) const;
+  /// prepare_neighbours() from its second pass on: expand_offsets_[0..n) holds the output counts and hr the
+  /// fluid's smoothing-length range (the step computes both in its kick loop).
+  void build_neighbours(const SmoothingRange& hr);
 
   SolverSettings settings_;
   ParticleStore<2> store_;
@@ -98,8 +110,8 @@ class Simulation {
   ParticleStore<2> last_good_;
   SweepLimits last_good_limits_;  // limits_ of the last good state (restored with it)
   // Step workspace of prepare_neighbours (reused, so a step allocates nothing once sizes settle).
-  std::vector<std::uint32_t> expand_src_, expand_offsets_, gather_src_;
-  std::vector<std::int8_t> expand_image_, gather_image_;
+  std::vector<std::uint32_t> expand_src_, expand_offsets_;
+  std::vector<std::int8_t> expand_image_;
   std::vector<Vec<2>> expand_x_;  // the state before the current step (watchdog rollback)
   double time_ = 0.0;
   std::uint64_t step_ = 0;

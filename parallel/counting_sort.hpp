@@ -31,27 +31,64 @@ void counting_sort(std::size_t n, std::size_t buckets, Key&& key, CountingSortRe
   scratch.assign(chunks * buckets, 0);  // layout: [bucket][chunk]
   auto& keys = out.keys;
   keys.resize(n);
-  parallel_for_dynamic(chunks, 1, [&](std::size_t c) {
-    const std::size_t end = std::min(n, (c + 1) * chunk);
-    for (std::size_t i = c * chunk; i < end; ++i) {
-      const auto k = static_cast<std::uint32_t>(key(i));
-      keys[i] = k;
-      ++scratch[k * chunks + c];
-    }
-  });
-  out.bucket_start.assign(buckets + 1, 0);
-  exclusive_scan(scratch.data(), scratch.data(), scratch.size());
-  parallel_for(buckets, [&](std::size_t b) {
-    out.bucket_start[b] = chunks ? scratch[b * chunks] : 0;
-  });
+  out.bucket_start.resize(buckets + 1);
   out.bucket_start[buckets] = static_cast<std::uint32_t>(n);
   out.order.resize(n);
-  parallel_for_dynamic(chunks, 1, [&](std::size_t c) {
-    const std::size_t end = std::min(n, (c + 1) * chunk);
-    for (std::size_t i = c * chunk; i < end; ++i) {
-      out.order[scratch[keys[i] * chunks + c]++] = static_cast<std::uint32_t>(i);
+  // The exclusive scan of the table, blocked like par::exclusive_scan (fixed kChunk blocks).
+  const std::size_t table = scratch.size();
+  const std::size_t blocks = chunk_count(table);
+  thread_local std::vector<std::uint32_t> block_total_buffer;  // reused; see par::reduce for the reference
+  std::vector<std::uint32_t>& block_total = block_total_buffer;
+  block_total.assign(blocks + 1, 0);
+  const auto n_chunks = static_cast<std::ptrdiff_t>(chunks);
+  const auto n_blocks = static_cast<std::ptrdiff_t>(blocks);
+  const auto n_buckets = static_cast<std::ptrdiff_t>(buckets);
+  std::uint32_t* t = scratch.data();
+  // One parallel region for the whole sort (each region costs a fork and a join); the worksharing loops'
+  // barriers order the phases: histogram, scan of the table (block totals, their serial scan, offsets),
+  // bucket starts, stable scatter.
+#pragma omp parallel
+  {
+#pragma omp for schedule(dynamic, 1)
+    for (std::ptrdiff_t c = 0; c < n_chunks; ++c) {
+      const auto cc = static_cast<std::size_t>(c);
+      const std::size_t end = std::min(n, (cc + 1) * chunk);
+      for (std::size_t i = cc * chunk; i < end; ++i) {
+        const auto k = static_cast<std::uint32_t>(key(i));
+        keys[i] = k;
+        ++t[k * chunks + cc];
+      }
     }
-  });
+#pragma omp for schedule(static)
+    for (std::ptrdiff_t b = 0; b < n_blocks; ++b) {
+      std::uint32_t acc = 0;
+      const std::size_t end = std::min(table, (static_cast<std::size_t>(b) + 1) * kChunk);
+      for (std::size_t i = static_cast<std::size_t>(b) * kChunk; i < end; ++i) acc += t[i];
+      block_total[static_cast<std::size_t>(b) + 1] = acc;
+    }
+#pragma omp single
+    for (std::size_t b = 0; b < blocks; ++b) block_total[b + 1] += block_total[b];
+#pragma omp for schedule(static)
+    for (std::ptrdiff_t b = 0; b < n_blocks; ++b) {
+      std::uint32_t acc = block_total[static_cast<std::size_t>(b)];
+      const std::size_t end = std::min(table, (static_cast<std::size_t>(b) + 1) * kChunk);
+      for (std::size_t i = static_cast<std::size_t>(b) * kChunk; i < end; ++i) {
+        const std::uint32_t v = t[i];
+        t[i] = acc;
+        acc += v;
+      }
+    }
+#pragma omp for schedule(static)
+    for (std::ptrdiff_t b = 0; b < n_buckets; ++b) {
+      out.bucket_start[static_cast<std::size_t>(b)] = chunks ? t[static_cast<std::size_t>(b) * chunks] : 0;
+    }
+#pragma omp for schedule(dynamic, 1)
+    for (std::ptrdiff_t c = 0; c < n_chunks; ++c) {
+      const auto cc = static_cast<std::size_t>(c);
+      const std::size_t end = std::min(n, (cc + 1) * chunk);
+      for (std::size_t i = cc * chunk; i < end; ++i) out.order[t[keys[i] * chunks + cc]++] = static_cast<std::uint32_t>(i);
+    }
+  }
 }
 
 template <class Key>

@@ -1,6 +1,6 @@
 #pragma once
 // Blocked exclusive prefix sum: per-chunk totals in parallel, a serial scan of the chunk totals, then each
-// chunk writes its own offsets. Chunk boundaries are fixed, so the result is the same at any thread count.
+// chunk writes its own offsets, all in one parallel region. Chunk boundaries are fixed, so the result is the same at any thread count.
 #include <cstddef>
 #include <vector>
 
@@ -13,26 +13,35 @@ template <class T>
 T exclusive_scan(const T* in, T* out, std::size_t n) {
   const std::size_t chunks = chunk_count(n);
   // Per calling thread and T, reused: no allocation once sizes settle. Bound to a reference so that the
-  // workers' lambdas see the calling thread's buffer (a thread_local is not captured).
+  // workers see the calling thread's buffer (a thread_local is not captured).
   thread_local std::vector<T> buffer;
   std::vector<T>& total = buffer;
   total.assign(chunks + 1, T{});
-  parallel_for(chunks, [&](std::size_t c) {
-    T acc{};
-    const std::size_t end = std::min(n, (c + 1) * kChunk);
-    for (std::size_t i = c * kChunk; i < end; ++i) acc += in[i];
-    total[c + 1] = acc;
-  });
-  for (std::size_t c = 0; c < chunks; ++c) total[c + 1] += total[c];
-  parallel_for(chunks, [&](std::size_t c) {
-    T acc = total[c];
-    const std::size_t end = std::min(n, (c + 1) * kChunk);
-    for (std::size_t i = c * kChunk; i < end; ++i) {
-      const T v = in[i];
-      out[i] = acc;
-      acc += v;
+  const auto count = static_cast<std::ptrdiff_t>(chunks);
+  // One parallel region (each costs a fork and a join): chunk totals, the serial scan of the totals by one
+  // thread, then each chunk's offsets.
+#pragma omp parallel
+  {
+#pragma omp for schedule(static)
+    for (std::ptrdiff_t c = 0; c < count; ++c) {
+      T acc{};
+      const std::size_t end = std::min(n, (static_cast<std::size_t>(c) + 1) * kChunk);
+      for (std::size_t i = static_cast<std::size_t>(c) * kChunk; i < end; ++i) acc += in[i];
+      total[static_cast<std::size_t>(c) + 1] = acc;
     }
-  });
+#pragma omp single
+    for (std::size_t c = 0; c < chunks; ++c) total[c + 1] += total[c];
+#pragma omp for schedule(static)
+    for (std::ptrdiff_t c = 0; c < count; ++c) {
+      T acc = total[static_cast<std::size_t>(c)];
+      const std::size_t end = std::min(n, (static_cast<std::size_t>(c) + 1) * kChunk);
+      for (std::size_t i = static_cast<std::size_t>(c) * kChunk; i < end; ++i) {
+        const T v = in[i];
+        out[i] = acc;
+        acc += v;
+      }
+    }
+  }
   return total[chunks];
 }
 

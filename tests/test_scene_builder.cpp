@@ -3,12 +3,15 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cstring>
+#include <limits>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "core/case_builder.hpp"
+#include "core/neighbour_cells.hpp"
 #include "core/scene/scene_builder.hpp"
 #include "core/scene/scene_parser.hpp"
 
@@ -142,3 +145,24 @@ TEST(SceneBuilder, DynamicRefinementStageRefinesFastParticles) {
 }
 
 }  // namespace
+
+// The grid's cells follow the finest fluid support (core/neighbour_cells.hpp), in scenes with Lennard-Jones
+// wall particles (h = 0) too: they once took part in the minimum, which fell to 0, and the cells were then
+// sized by the grid's memory budget. Checked after set-up (refresh) and after a step (the step's own path).
+TEST(SceneBuilder, TheGridIsSizedByTheFinestFluidSupportInScenesWithWallParticles) {
+  for (const char* file : {"dam_break.json", "dam_break_refined.json", "drop.json"}) {
+    SCOPED_TRACE(file);
+    Simulation sim = scene::build_simulation(scene::load_scene(kCases / file));
+    ASSERT_GT(sim.diagnostics().walls, 0u) << "the check is about scenes with wall particles";
+    for (int pass = 0; pass < 2; ++pass) {
+      double h_min = std::numeric_limits<double>::infinity();
+      const auto& st = sim.store();
+      for (std::size_t i = 0; i < st.size(); ++i) {
+        if (st.kind[i] == Kind::fluid) h_min = std::min(h_min, st.h[i]);
+      }
+      // CellGrid pads the requested size by a relative 1e-6 (its rounding margin); nothing else may change it.
+      EXPECT_DOUBLE_EQ(sim.grid().cell_size(), kCellPerFinestH * h_min * (1.0 + 1e-6));
+      sim.step();
+    }
+  }
+}

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/cell_grid.hpp"
+#include "core/neighbour_cells.hpp"
 #include "core/particle_store.hpp"
 
 namespace sph::refine {
@@ -13,13 +14,9 @@ namespace sph::refine {
 class NeighbourQuery {
  public:
   explicit NeighbourQuery(const ParticleStore<2>& store) : store_(store) {
-    double hmax = 0.0, hmin = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < store.size(); ++i) {
-      hmax = std::max(hmax, store.h[i]);
-      hmin = std::min(hmin, store.h[i]);
-    }
-    // Cells as wide as the finest support; each query reaches h_i + hmax (see CellGrid).
-    grid_.build(store.x.data(), store.size(), std::max(2.0 * std::min(hmin, hmax), 1e-12), hmax);
+    // The step's cell size rule (core/neighbour_cells.hpp); each query reaches h_i + h_max (see CellGrid).
+    const SmoothingRange hr = smoothing_range(store);
+    grid_.build(store.x.data(), store.size(), neighbour_cell_size(hr), hr.max);
   }
 
   /// Calls f(j, r) for every fluid particle j != i with r_ij < 2 h_ij, in a fixed order.
