@@ -5,7 +5,11 @@
 #include <omp.h>
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -55,6 +59,36 @@ void print_summary(const scene::Scene& s, const scene::RunSummary& r, const std:
 }
 
 }  // namespace
+
+namespace {
+// A step runs a few dozen parallel regions, each a fork and a barrier over every thread: past a few threads
+// per processor more threads only add waiting and switching, so they only slow a run. Far past it they fail
+// outright (tens of thousands of threads: a crash, or minutes before the first step).
+constexpr int kThreadsPerProcessor = 4;
+}  // namespace
+
+int max_threads_option() { return kThreadsPerProcessor * std::max(1, omp_get_num_procs()); }
+
+std::string threads_option_error(const std::string& value) {
+  long long n = 0;
+  const char* end = value.data() + value.size();
+  const auto [ptr, ec] = std::from_chars(value.data(), end, n);
+  const int most = max_threads_option();
+  if (ec != std::errc() || ptr != end || n < 1 || n > most) {
+    return "must be a whole number from 1 to " + std::to_string(most) + " (got '" + value + "'; more than " +
+           std::to_string(kThreadsPerProcessor) + " per processor only slow a run)";
+  }
+  return "";
+}
+
+std::string checkpoint_every_option_error(const std::string& value) {
+  char* end = nullptr;
+  const double t = value.empty() ? 0.0 : std::strtod(value.c_str(), &end);
+  if (value.empty() || end != value.c_str() + value.size() || !std::isfinite(t) || !(t > 0.0)) {
+    return "must be a positive number of simulated seconds (got '" + value + "')";
+  }
+  return "";
+}
 
 int run_command(const RunArguments& args) {
   scene::Scene s;

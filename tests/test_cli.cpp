@@ -190,6 +190,34 @@ TEST_F(Cli, CommandLineMistakesExitTwo) {
   EXPECT_EQ(run("--help").code, 0);
 }
 
+TEST_F(Cli, BadThreadCountsAndCheckpointIntervalsAreNamedPlainly) {
+  // Each value exits 2 with one plain rule naming the option (CLI11's range check printed the 300 digits of
+  // the largest double; 100000 threads crashed and 20000 ran for minutes), and creates nothing.
+  write_scene("tiny.json", kTiny);
+  for (const char* value : {"0", "-3", "100000", "20000", "1.5", "abc", "99999999999999999999"}) {
+    const Result r = run(std::string("run tiny.json -q -o out --threads ") + value);
+    SCOPED_TRACE(value);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(r.err.rfind("--threads: must be a whole number from 1 to ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(std::string("(got '") + value + "'; more than 4 per processor only slow a run)"), std::string::npos)
+        << r.err;
+    EXPECT_LT(r.err.size(), 200u) << r.err;
+  }
+  for (const char* value : {"0", "-1", "abc", "nan", "inf", "1s"}) {
+    const Result r = run(std::string("run tiny.json -q -o out --checkpoint-every ") + value);
+    SCOPED_TRACE(value);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(r.err.rfind(std::string("--checkpoint-every: must be a positive number of simulated seconds (got '") + value + "')", 0), 0u)
+        << r.err;
+    EXPECT_LT(r.err.size(), 200u) << r.err;
+  }
+  EXPECT_EQ(work_files(), std::vector<std::string>{"tiny.json"});
+  // The largest count is stated in the help, from the processors this machine has.
+  const Result help = run("run --help");
+  EXPECT_EQ(help.code, 0);
+  EXPECT_NE(help.out.find("--threads INT:1.."), std::string::npos) << help.out;
+}
+
 TEST_F(Cli, RunWritesItsFolderAndRefusesToOverwriteWithoutForce) {
   write_scene("tiny.json", kTiny);
   const Result first = run("run tiny.json --threads 1");
