@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/progress.hpp"
+#include "core/io/hdf5_frames.hpp"
 #include "core/scene/runner.hpp"
 #include "core/scene/scene_builder.hpp"
 #include "core/scene/scene_parser.hpp"
@@ -103,6 +104,10 @@ int run_command(const RunArguments& args) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(args.resume, ec)) {
       std::fprintf(stderr, "error: --resume: no such checkpoint file '%s'\n", args.resume.c_str());
+      return kExitUsage;
+    }
+    if (const std::string why = io::checkpoint_problem(args.resume); !why.empty()) {
+      std::fprintf(stderr, "error: --resume: %s is not a sphrefine checkpoint (%s)\n", args.resume.c_str(), why.c_str());
       return kExitUsage;
     }
     if (args.force) {

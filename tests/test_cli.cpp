@@ -261,6 +261,40 @@ TEST_F(Cli, CheckpointAndResumeThroughTheProgram) {
   EXPECT_EQ(other.err.rfind("scene error: --resume: the checkpoint was written by a different scene", 0), 0u) << other.err;
 }
 
+TEST_F(Cli, ResumeFromAFileThatIsNotACheckpointExitsTwoAndWritesNothing) {
+  write_scene("tiny.json", kTiny);
+  ASSERT_EQ(run("run tiny.json -q -o a").code, 0);
+  const fs::path a = dir_ / "work" / "a";
+  const auto files_before = work_files();
+  const auto series_before = fs::last_write_time(a / "series.csv");
+  struct Case {
+    std::string file, why;
+  };
+  for (const Case& c : {Case{"tiny.json", "not an HDF5 file"},
+                        Case{"a/frames/frame_000000.h5", "an HDF5 file without the 'checkpoint' group"}}) {
+    for (const char* out : {"a", "b"}) {
+      const Result r = run("run tiny.json -q -o " + std::string(out) + " --resume " + c.file);
+      SCOPED_TRACE(c.file + " -o " + out);
+      EXPECT_EQ(r.code, 2);
+      EXPECT_EQ(r.err, "error: --resume: " + c.file + " is not a sphrefine checkpoint (" + c.why + ")\n");
+      EXPECT_EQ(work_files(), files_before);
+      EXPECT_EQ(fs::last_write_time(a / "series.csv"), series_before);
+    }
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "work" / "b"));
+}
+
+TEST_F(Cli, ADirectoryIsNotASceneFile) {
+  fs::create_directories(dir_ / "scenes");
+  for (const char* command : {"run ../scenes -o out -q", "validate ../scenes"}) {
+    const Result r = run(command);
+    SCOPED_TRACE(command);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(r.err, "scene error: ../scenes: is a directory, not a scene file\n");
+    EXPECT_TRUE(work_files().empty());
+  }
+}
+
 TEST_F(Cli, AKilledRunLeavesEveryListedFrameReadable) {
   // Frames every millisecond of simulated time; the run is killed (SIGKILL) part-way.
   write_scene("tiny.json", tiny_with("\"end\": 0.02, \"output_interval\": 0.005",

@@ -389,6 +389,17 @@ TEST(SceneParser, OverridesEditTheDocumentBeforeValidation) {
   EXPECT_EQ(override_error("time.end.x=1"), "scene error: --set time.end.x: time.end is not an object");
 }
 
+TEST(SceneParser, ADirectoryIsNotASceneFile) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path();
+  try {
+    (void)load_scene(dir);
+    FAIL();
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.what(), "scene error: " + dir.string() + ": is a directory, not a scene file");
+    EXPECT_EQ(e.exit_code(), 2);
+  }
+}
+
 TEST(SceneParser, MissingFileIsASceneError) {
   try {
     (void)load_scene("/nonexistent/scene.json");
