@@ -57,9 +57,11 @@ class Cli : public ::testing::Test {
   }
 
   /// Runs the program with `args` (shell words) in the work folder; stdout and stderr go to files outside it.
-  Result run(const std::string& args) {
-    const std::string cmd = "cd '" + (dir_ / "work").string() + "' && OMP_NUM_THREADS=1 '" + program().string() + "' " +
-                            args + " > '" + (dir_ / "stdout").string() + "' 2> '" + (dir_ / "stderr").string() + "'";
+  /// `limits`: shell commands before it (ulimit).
+  Result run(const std::string& args, const std::string& limits = "") {
+    const std::string cmd = "cd '" + (dir_ / "work").string() + "' && " + limits + " OMP_NUM_THREADS=1 '" +
+                            program().string() + "' " + args + " > '" + (dir_ / "stdout").string() + "' 2> '" +
+                            (dir_ / "stderr").string() + "'";
     const int status = std::system(cmd.c_str());
     Result r;
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -123,6 +125,8 @@ TEST_F(Cli, ValidateAGoodSceneWritesNothing) {
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("scene OK: tiny"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("fluid particles    200"), std::string::npos) << r.out;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(\n  memory             about \d+ MiB \([\d,]+ particles at ~\d+ B each\) at the start, [\d.]+ GiB available\n)")))
+      << r.out;
   EXPECT_EQ(work_files(), std::vector<std::string>{"tiny.json"});
 }
 
@@ -259,6 +263,29 @@ TEST_F(Cli, CheckpointAndResumeThroughTheProgram) {
   const Result other = run("run tiny.json -o a --resume a/checkpoint.h5 --set h_factor=1.5");
   EXPECT_EQ(other.code, 2);
   EXPECT_EQ(other.err.rfind("scene error: --resume: the checkpoint was written by a different scene", 0), 0u) << other.err;
+}
+
+TEST_F(Cli, ASceneTooBigForMemoryIsRefusedBeforeAnythingIsAllocated) {
+  // 48 million lattice points (under the 5e7 cap), quadrupled by a static refinement pass, in a sheet six
+  // refined rows thick on the floor of a 12 km tank: with h_factor 3 every particle has a ghost below the
+  // floor. About 137 GiB at the start: more than any CI machine has (< 100 GiB). The program runs under a
+  // 4 GB address-space limit, so that without the check it fails at once instead of taking the machine's memory.
+  write_scene("huge.json", R"({
+    "container": { "lo": [0, 0], "hi": [12000, 1] },
+    "fluid": [ { "shape": "rectangle", "lo": [0, 0], "hi": [12000, 0.004], "spacing": 0.001 } ],
+    "h_factor": 3,
+    "material": { "rho0": 1000, "c0": 10 },
+    "effects": { "ghost_walls": "free-slip", "static_refinement": {} },
+    "time": { "end": 0.001 }
+  })");
+  for (const char* command : {"validate huge.json", "run huge.json -q -o out"}) {
+    const Result r = run(command, "ulimit -v 4000000 &&");
+    SCOPED_TRACE(command);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_TRUE(std::regex_match(r.err, std::regex(R"(error: the scene needs about 1\d\d\.\d GiB \(3\d\d,\d\d\d,\d\d\d particles at ~\d\d\d B each\) but [\d.]+ [MG]iB are available\n)")))
+        << r.err;
+    EXPECT_EQ(work_files(), std::vector<std::string>{"huge.json"});
+  }
 }
 
 TEST_F(Cli, ResumeFromAFileThatIsNotACheckpointExitsTwoAndWritesNothing) {

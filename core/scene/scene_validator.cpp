@@ -263,9 +263,7 @@ void validate_scene(const Scene& s) {
                " m exceeds the repulsion range r0 = r0_factor * d = " + num(r0) + " m of its particles (d = " + num(d) +
                (w.spacing ? " m); lower the refinement level or the wall spacing" : " m); raise r0_factor to 0.5 or more"));
     }
-    double extent = 2.0 * (s.container.box.hi - s.container.box.lo).sum();
-    for (const auto& o : s.obstacles) extent += 2.0 * (o.hi - o.lo).sum();
-    if (extent / ws > kMaxParticles) fail(p + ".spacing", "would create more than " + num(kMaxParticles) + " wall particles");
+    if (estimated_wall_particles(s) > kMaxParticles) fail(p + ".spacing", "would create more than " + num(kMaxParticles) + " wall particles");
   }
 
   const Time& t = s.time;
