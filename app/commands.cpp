@@ -5,12 +5,19 @@
 #include <omp.h>
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
 
 #include "app/progress.hpp"
+#include "core/io/hdf5_frames.hpp"
 #include "core/scene/runner.hpp"
 #include "core/scene/scene_builder.hpp"
 #include "core/scene/scene_parser.hpp"
@@ -55,7 +62,127 @@ void print_summary(const scene::Scene& s, const scene::RunSummary& r, const std:
   }
 }
 
+/// The first line of `file` that starts with `key` (then whitespace or ':'), as the number after it; nullopt
+/// when there is none. `key` empty: the file's first word as a number ("max" is not one).
+std::optional<double> read_number(const std::filesystem::path& file, const std::string& key = "") {
+  std::ifstream in(file);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream words(line);
+    std::string first;
+    words >> first;
+    if (!key.empty()) {
+      if (first != key && first != key + ":") continue;
+      words >> first;
+    }
+    char* end = nullptr;
+    const double x = std::strtod(first.c_str(), &end);
+    if (first.empty() || *end != '\0' || !std::isfinite(x)) return std::nullopt;
+    return x;
+  }
+  return std::nullopt;
+}
+
+/// The path of this process's cgroup (from /proc/self/cgroup): in cgroup v2 the line "0::/a/b", in cgroup v1
+/// the memory controller's line "4:memory:/a/b".
+std::string own_cgroup(bool v2) {
+  std::ifstream in("/proc/self/cgroup");
+  std::string line;
+  while (std::getline(in, line)) {
+    const std::size_t a = line.find(':'), b = line.find(':', a + 1);
+    if (a == std::string::npos || b == std::string::npos) continue;
+    std::string controllers(1, ',');  // ",memory," or ",," (v2)
+    controllers.append(line, a + 1, b - a - 1).push_back(',');
+    if (v2 ? line.compare(0, a, "0") == 0 && controllers == ",," : controllers.find(",memory,") != std::string::npos) {
+      return line.substr(b + 1);
+    }
+  }
+  return "";
+}
+
+/// What a cgroup memory limit leaves this process (bytes), when one is set: the limit less the usage, the
+/// usage without the page cache the kernel can drop (inactive_file). cgroup v2 (memory.max) or v1.
+std::optional<double> cgroup_memory_left() {
+  struct Hierarchy {
+    bool v2;
+    const char* root;
+    const char *limit, *usage, *inactive;
+  };
+  for (const Hierarchy& h : {Hierarchy{true, "/sys/fs/cgroup", "memory.max", "memory.current", "inactive_file"},
+                             Hierarchy{false, "/sys/fs/cgroup/memory", "memory.limit_in_bytes", "memory.usage_in_bytes",
+                                       "total_inactive_file"}}) {
+    // Inside a container the process's own cgroup is usually the hierarchy's root as mounted there.
+    for (const std::filesystem::path& dir : {std::filesystem::path(h.root + own_cgroup(h.v2)), std::filesystem::path(h.root)}) {
+      const std::optional<double> limit = read_number(dir / h.limit);
+      const std::optional<double> usage = read_number(dir / h.usage);
+      if (!limit || !usage) continue;  // no such file, or no limit ("max")
+      const double inactive = read_number(dir / "memory.stat", h.inactive).value_or(0.0);
+      return std::max(0.0, *limit - std::max(0.0, *usage - inactive));
+    }
+  }
+  return std::nullopt;
+}
+
+/// The memory this process can still take (bytes): MemAvailable of /proc/meminfo, lowered to what a cgroup
+/// limit leaves; nullopt when neither is known.
+std::optional<double> available_memory() {
+  std::optional<double> available;
+  if (const auto kib = read_number("/proc/meminfo", "MemAvailable")) available = *kib * 1024.0;
+  if (const auto left = cgroup_memory_left()) available = std::min(available.value_or(*left), *left);
+  return available;
+}
+
+/// Whether a run of the scene fits in the memory available, checked before anything is allocated. When it does
+/// not, prints the estimate and the memory available and returns false. `report`, when given, receives the
+/// estimate (validate prints it). An unknown amount available is not checked.
+bool memory_fits(const scene::Scene& s, std::string* report = nullptr) {
+  const scene::MemoryEstimate need = scene::estimated_memory(s, omp_get_max_threads());
+  const std::optional<double> available = available_memory();
+  if (available) {
+    const std::string refusal = scene::memory_refusal(need, *available);
+    if (!refusal.empty()) {
+      std::fprintf(stderr, "error: %s\n", refusal.c_str());
+      return false;
+    }
+  }
+  if (report) {
+    *report = scene::to_string(need) + " at the start, " + (available ? scene::memory_text(*available) : "unknown") +
+              " available";
+  }
+  return true;
+}
+
 }  // namespace
+
+namespace {
+// A step runs a few dozen parallel regions, each a fork and a barrier over every thread: past a few threads
+// per processor more threads only add waiting and switching, so they only slow a run. Far past it they fail
+// outright (tens of thousands of threads: a crash, or minutes before the first step).
+constexpr int kThreadsPerProcessor = 4;
+}  // namespace
+
+int max_threads_option() { return kThreadsPerProcessor * std::max(1, omp_get_num_procs()); }
+
+std::string threads_option_error(const std::string& value) {
+  long long n = 0;
+  const char* end = value.data() + value.size();
+  const auto [ptr, ec] = std::from_chars(value.data(), end, n);
+  const int most = max_threads_option();
+  if (ec != std::errc() || ptr != end || n < 1 || n > most) {
+    return "must be a whole number from 1 to " + std::to_string(most) + " (got '" + value + "'; more than " +
+           std::to_string(kThreadsPerProcessor) + " per processor only slow a run)";
+  }
+  return "";
+}
+
+std::string checkpoint_every_option_error(const std::string& value) {
+  char* end = nullptr;
+  const double t = value.empty() ? 0.0 : std::strtod(value.c_str(), &end);
+  if (value.empty() || end != value.c_str() + value.size() || !std::isfinite(t) || !(t > 0.0)) {
+    return "must be a positive number of simulated seconds (got '" + value + "')";
+  }
+  return "";
+}
 
 int run_command(const RunArguments& args) {
   scene::Scene s;
@@ -72,6 +199,10 @@ int run_command(const RunArguments& args) {
       std::fprintf(stderr, "error: --resume: no such checkpoint file '%s'\n", args.resume.c_str());
       return kExitUsage;
     }
+    if (const std::string why = io::checkpoint_problem(args.resume); !why.empty()) {
+      std::fprintf(stderr, "error: --resume: %s is not a sphrefine checkpoint (%s)\n", args.resume.c_str(), why.c_str());
+      return kExitUsage;
+    }
     if (args.force) {
       std::fprintf(stderr, "error: --resume continues the run in its folder; --force would erase it\n");
       return kExitUsage;
@@ -83,6 +214,7 @@ int run_command(const RunArguments& args) {
     return kExitFolderHoldsRun;
   }
   if (args.threads > 0) omp_set_num_threads(args.threads);
+  if (!memory_fits(s)) return kExitUsage;
 
   scene::RunOptions options;
   options.folder = folder;
@@ -124,6 +256,8 @@ int validate_command(const std::string& path, const std::vector<std::string>& ov
   } catch (const scene::SceneError& e) {
     return scene_error(e);
   }
+  std::string memory;
+  if (!memory_fits(s, &memory)) return kExitUsage;
   try {
     const Simulation sim = scene::build_simulation(s);
     const Diagnostics d = sim.diagnostics();
@@ -133,6 +267,7 @@ int validate_command(const std::string& path, const std::vector<std::string>& ov
                 scene::finest_level(s), scene::finest_spacing(s));
     std::printf("  sweep              %s%s\n", sim.sweep_name(), s.effects.ghost_walls ? ", ghost walls" : "");
     std::printf("  first time step    %.6g s, end time %.6g s\n", sim.dt(), s.time.end);
+    std::printf("  memory             %s\n", memory.c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: the scene passed validation but could not be set up: %s\n", e.what());
     return kExitFailure;

@@ -23,6 +23,13 @@ struct RunArguments {
   bool quiet = false;
 };
 
+/// The largest --threads value: 4 threads per processor the process may run on (omp_get_num_procs()).
+int max_threads_option();
+/// The rule a --threads value breaks ("" when it is a whole number from 1 to max_threads_option()).
+std::string threads_option_error(const std::string& value);
+/// The rule a --checkpoint-every value breaks ("" when it is a positive, finite number of seconds).
+std::string checkpoint_every_option_error(const std::string& value);
+
 int run_command(const RunArguments& args);
 int validate_command(const std::string& scene, const std::vector<std::string>& overrides);
 int info_command();

@@ -17,15 +17,15 @@ int main(int argc, char** argv) {
   CLI::App* run_cmd = app.add_subcommand("run", "Run a scene file to its end time, writing its outputs");
   run_cmd->add_option("scene", run.scene, "Scene file (JSON, docs/SCENES.md)")->required();
   run_cmd->add_option("-o,--output", run.output, "Output folder (default: output.folder, else out/<name>)");
-  run_cmd->add_option("--threads", run.threads, "OpenMP threads (default: OMP_NUM_THREADS or all)")
-      ->check(CLI::PositiveNumber);
+  run_cmd->add_option("--threads", run.threads, "OpenMP threads (default: one per 4096 fluid particles, at most OMP_NUM_THREADS or the processors)")
+      ->check(CLI::Validator(sph::app::threads_option_error, "1.." + std::to_string(sph::app::max_threads_option())));
   run_cmd->add_option("--set", run.overrides, "Override a scene key before validation: key.path=value (repeatable)")
       ->expected(1)
       ->take_all();
   run_cmd->add_flag("--force", run.force, "Overwrite an output folder that already holds a run");
   run_cmd->add_option("--checkpoint-every", run.checkpoint_every,
                       "Write <output>/checkpoint.h5 every T simulated seconds and at the end")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Validator(sph::app::checkpoint_every_option_error, "SECONDS > 0"));
   run_cmd->add_option("--resume", run.resume, "Continue the run in the output folder from this checkpoint");
   run_cmd->add_flag("-q,--quiet", run.quiet, "No progress line and no banner");
 

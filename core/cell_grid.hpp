@@ -35,6 +35,13 @@ class CellGrid {
   static std::size_t cell_budget(std::size_t n) {
     return std::min(kMaxCells, std::max<std::size_t>(std::size_t{1} << 16, 16 * n));
   }
+  /// Upper bound on the bytes build() holds for n particles sorted with `threads` threads: the order and the
+  /// keys (one index each a particle) and, at the full cell budget, the cell starts and the counting sort's
+  /// histograms (one index a cell, and one a cell for each thread's chunk). For memory estimates.
+  static std::size_t bytes_bound(std::size_t n, int threads) {
+    const auto chunks = static_cast<std::size_t>(std::max(1, threads));
+    return sizeof(std::uint32_t) * (2 * n + (1 + chunks) * cell_budget(n));
+  }
 
   /// A bounding box; a non-finite point makes it infinite (a NaN would vanish in min/max), which build()
   /// refuses.

@@ -57,10 +57,11 @@ class Cli : public ::testing::Test {
   }
 
   /// Runs the program with `args` (shell words) in the work folder; stdout and stderr go to files outside it.
-  /// `env` is a prefix of `env` (1) words: variables to set or (-u NAME) unset for the program.
-  Result run(const std::string& args, const std::string& env = "OMP_NUM_THREADS=1") {
-    const std::string cmd = "cd '" + (dir_ / "work").string() + "' && env " + env + " '" + program().string() + "' " +
-                            args + " > '" + (dir_ / "stdout").string() + "' 2> '" + (dir_ / "stderr").string() + "'";
+  /// `env`: words for env(1) (variables to set, or -u NAME to unset); `limits`: shell commands before it (ulimit).
+  Result run(const std::string& args, const std::string& env = "OMP_NUM_THREADS=1", const std::string& limits = "") {
+    const std::string cmd = "cd '" + (dir_ / "work").string() + "' && " + limits + " env " + env + " '" +
+                            program().string() + "' " + args + " > '" + (dir_ / "stdout").string() + "' 2> '" +
+                            (dir_ / "stderr").string() + "'";
     const int status = std::system(cmd.c_str());
     Result r;
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -148,6 +149,8 @@ TEST_F(Cli, ValidateAGoodSceneWritesNothing) {
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("scene OK: tiny"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("fluid particles    200"), std::string::npos) << r.out;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(\n  memory             about \d+ MiB \([\d,]+ particles at ~\d+ B each\) at the start, [\d.]+ GiB available\n)")))
+      << r.out;
   EXPECT_EQ(work_files(), std::vector<std::string>{"tiny.json"});
 }
 
@@ -168,6 +171,10 @@ TEST_F(Cli, EveryKindOfBadInputExitsTwoWithOneMessageAndCreatesNothing) {
       {tiny_with("\"hi\": [1, 2]", "\"hi\": [5, 2]"), "", "scene error: fluid[0]: the rectangle reaches outside the container"},
       {tiny_with("\"hi\": [1, 2]", "\"hi\": [3.2, 2]"), "",
        "scene error: fluid[0]: overlaps obstacles[0] (fluid must start outside every obstacle)"},
+      {tiny_with("\"hydrostatic\": true } ]",
+                 "\"hydrostatic\": true }, { \"shape\": \"rectangle\", \"lo\": [0.5, 0], \"hi\": [1.5, 1], \"spacing\": 0.1 } ]"),
+       "",
+       "scene error: fluid[1]: overlaps fluid[0] (fluid[1]: rectangle [0.5, 0] .. [1.5, 1]; fluid[0]: rectangle [0, 0] .. [1, 2])"},
       {tiny_with("\"lennard_jones_wall\": { \"reference_height\": 2 }",
                  "\"lennard_jones_wall\": { \"reference_height\": 2, \"spacing\": 0.1 }"),
        "",
@@ -209,6 +216,34 @@ TEST_F(Cli, CommandLineMistakesExitTwo) {
   EXPECT_EQ(run("run tiny.json --resume nowhere.h5").code, 2);
   EXPECT_EQ(work_files(), std::vector<std::string>{"tiny.json"});
   EXPECT_EQ(run("--help").code, 0);
+}
+
+TEST_F(Cli, BadThreadCountsAndCheckpointIntervalsAreNamedPlainly) {
+  // Each value exits 2 with one plain rule naming the option (CLI11's range check printed the 300 digits of
+  // the largest double; 100000 threads crashed and 20000 ran for minutes), and creates nothing.
+  write_scene("tiny.json", kTiny);
+  for (const char* value : {"0", "-3", "100000", "20000", "1.5", "abc", "99999999999999999999"}) {
+    const Result r = run(std::string("run tiny.json -q -o out --threads ") + value);
+    SCOPED_TRACE(value);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(r.err.rfind("--threads: must be a whole number from 1 to ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(std::string("(got '") + value + "'; more than 4 per processor only slow a run)"), std::string::npos)
+        << r.err;
+    EXPECT_LT(r.err.size(), 200u) << r.err;
+  }
+  for (const char* value : {"0", "-1", "abc", "nan", "inf", "1s"}) {
+    const Result r = run(std::string("run tiny.json -q -o out --checkpoint-every ") + value);
+    SCOPED_TRACE(value);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(r.err.rfind(std::string("--checkpoint-every: must be a positive number of simulated seconds (got '") + value + "')", 0), 0u)
+        << r.err;
+    EXPECT_LT(r.err.size(), 200u) << r.err;
+  }
+  EXPECT_EQ(work_files(), std::vector<std::string>{"tiny.json"});
+  // The largest count is stated in the help, from the processors this machine has.
+  const Result help = run("run --help");
+  EXPECT_EQ(help.code, 0);
+  EXPECT_NE(help.out.find("--threads INT:1.."), std::string::npos) << help.out;
 }
 
 TEST_F(Cli, RunWritesItsFolderAndRefusesToOverwriteWithoutForce) {
@@ -260,6 +295,63 @@ TEST_F(Cli, CheckpointAndResumeThroughTheProgram) {
   const Result other = run("run tiny.json -o a --resume a/checkpoint.h5 --set h_factor=1.5");
   EXPECT_EQ(other.code, 2);
   EXPECT_EQ(other.err.rfind("scene error: --resume: the checkpoint was written by a different scene", 0), 0u) << other.err;
+}
+
+TEST_F(Cli, ASceneTooBigForMemoryIsRefusedBeforeAnythingIsAllocated) {
+  // 48 million lattice points (under the 5e7 cap), quadrupled by a static refinement pass, in a sheet six
+  // refined rows thick on the floor of a 12 km tank: with h_factor 3 every particle has a ghost below the
+  // floor. About 137 GiB at the start: more than any CI machine has (< 100 GiB). The program runs under a
+  // 4 GB address-space limit, so that without the check it fails at once instead of taking the machine's memory.
+  write_scene("huge.json", R"({
+    "container": { "lo": [0, 0], "hi": [12000, 1] },
+    "fluid": [ { "shape": "rectangle", "lo": [0, 0], "hi": [12000, 0.004], "spacing": 0.001 } ],
+    "h_factor": 3,
+    "material": { "rho0": 1000, "c0": 10 },
+    "effects": { "ghost_walls": "free-slip", "static_refinement": {} },
+    "time": { "end": 0.001 }
+  })");
+  for (const char* command : {"validate huge.json", "run huge.json -q -o out"}) {
+    const Result r = run(command, "OMP_NUM_THREADS=1", "ulimit -v 4000000 &&");
+    SCOPED_TRACE(command);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_TRUE(std::regex_match(r.err, std::regex(R"(error: the scene needs about 1\d\d\.\d GiB \(3\d\d,\d\d\d,\d\d\d particles at ~\d\d\d B each\) but [\d.]+ [MG]iB are available\n)")))
+        << r.err;
+    EXPECT_EQ(work_files(), std::vector<std::string>{"huge.json"});
+  }
+}
+
+TEST_F(Cli, ResumeFromAFileThatIsNotACheckpointExitsTwoAndWritesNothing) {
+  write_scene("tiny.json", kTiny);
+  ASSERT_EQ(run("run tiny.json -q -o a").code, 0);
+  const fs::path a = dir_ / "work" / "a";
+  const auto files_before = work_files();
+  const auto series_before = fs::last_write_time(a / "series.csv");
+  struct Case {
+    std::string file, why;
+  };
+  for (const Case& c : {Case{"tiny.json", "not an HDF5 file"},
+                        Case{"a/frames/frame_000000.h5", "an HDF5 file without the 'checkpoint' group"}}) {
+    for (const char* out : {"a", "b"}) {
+      const Result r = run("run tiny.json -q -o " + std::string(out) + " --resume " + c.file);
+      SCOPED_TRACE(c.file + " -o " + out);
+      EXPECT_EQ(r.code, 2);
+      EXPECT_EQ(r.err, "error: --resume: " + c.file + " is not a sphrefine checkpoint (" + c.why + ")\n");
+      EXPECT_EQ(work_files(), files_before);
+      EXPECT_EQ(fs::last_write_time(a / "series.csv"), series_before);
+    }
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "work" / "b"));
+}
+
+TEST_F(Cli, ADirectoryIsNotASceneFile) {
+  fs::create_directories(dir_ / "scenes");
+  for (const char* command : {"run ../scenes -o out -q", "validate ../scenes"}) {
+    const Result r = run(command);
+    SCOPED_TRACE(command);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(r.err, "scene error: ../scenes: is a directory, not a scene file\n");
+    EXPECT_TRUE(work_files().empty());
+  }
 }
 
 TEST_F(Cli, AKilledRunLeavesEveryListedFrameReadable) {

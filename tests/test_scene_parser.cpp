@@ -2,6 +2,7 @@
 // and each kind of bad input is refused with one "scene error: <key.path>: <rule>" naming the key.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 
@@ -224,6 +225,54 @@ TEST(SceneParser, RegionInsideAnObstacleIsRefused) {
             "scene error: fluid[0]: overlaps obstacles[0] (fluid must start outside every obstacle)");
 }
 
+/// A rectangle region (level 0, spacing 0.5) as JSON.
+Json rectangle(double x0, double y0, double x1, double y1, double spacing = 0.5) {
+  return Json{{"shape", "rectangle"}, {"lo", Json::array({x0, y0})}, {"hi", Json::array({x1, y1})}, {"spacing", spacing}};
+}
+Json circle(double x, double y, double radius) {
+  return Json{{"shape", "circle"}, {"centre", Json::array({x, y})}, {"radius", radius}, {"spacing", 0.5}};
+}
+
+TEST(SceneParser, OverlappingFluidRegionsAreRefused) {
+  // full_scene: fluid[0] the rectangle [0, 0] .. [5, 5], fluid[1] the circle at [8, 7] radius 1.
+  auto with_region = [](const Json& region) {
+    Json doc = full_scene();
+    doc["fluid"].push_back(region);
+    return doc;
+  };
+  // Rectangle and rectangle: the message names both regions, with their extents.
+  EXPECT_EQ(error_of(with_region(rectangle(4, 4, 6, 6))),
+            "scene error: fluid[2]: overlaps fluid[0] (fluid[2]: rectangle [4, 4] .. [6, 6]; fluid[0]: rectangle [0, 0] .. "
+            "[5, 5]); fluid regions must not overlap, or the common part would hold the particles of both");
+  EXPECT_NE(error_of(with_region(rectangle(1, 1, 2, 2))).find("fluid[2]: overlaps fluid[0]"), std::string::npos)
+      << "a rectangle inside another";
+  // Circle and rectangle, either order.
+  EXPECT_EQ(error_of(with_region(circle(5.5, 4, 1))).rfind("scene error: fluid[2]: overlaps fluid[0] (fluid[2]: circle at "
+                                                          "[5.5, 4] radius 1; fluid[0]: rectangle [0, 0] .. [5, 5])", 0),
+            0u)
+      << error_of(with_region(circle(5.5, 4, 1)));
+  EXPECT_EQ(error_of(with_region(rectangle(7, 5, 9, 6.5))).rfind("scene error: fluid[2]: overlaps fluid[1] (", 0), 0u)
+      << error_of(with_region(rectangle(7, 5, 9, 6.5)));
+  EXPECT_EQ(error_of(with_region(circle(2.5, 2.5, 0.5))).rfind("scene error: fluid[2]: overlaps fluid[0] (", 0), 0u)
+      << "a circle inside a rectangle";
+  // Circle and circle, overlapping or touching (both lattices would hold the point of contact [9, 7]).
+  EXPECT_EQ(error_of(with_region(circle(9.5, 7, 1))).rfind("scene error: fluid[2]: overlaps or touches fluid[1] (", 0), 0u)
+      << error_of(with_region(circle(9.5, 7, 1)));
+  EXPECT_NE(error_of(with_region(circle(10, 7, 1))).find("circles must not touch"), std::string::npos)
+      << error_of(with_region(circle(10, 7, 1)));
+
+  // Regions that only touch are accepted: rectangles sharing an edge (same or different spacing) or a corner,
+  // a circle touching a rectangle's side or corner, circles apart.
+  for (const Json& region : {rectangle(5, 0, 7, 5), rectangle(0, 5, 5, 6, 0.25), rectangle(5, 5, 6, 6), circle(6, 4, 1),
+                             circle(5.5, 5.5, std::sqrt(0.5)), rectangle(7, 5, 9, 6), circle(10.5, 7, 1)}) {
+    EXPECT_EQ(error_of(with_region(region)), "") << region.dump();
+  }
+  // Coordinates given as decimals: 0.1 + 0.2 is not exactly 0.3, still only touching.
+  Json doc = with_region(rectangle(0.1 + 0.2, 5, 4, 6));
+  doc["fluid"].push_back(rectangle(0, 5, 0.3, 6, 0.1));
+  EXPECT_EQ(error_of(doc), "");
+}
+
 TEST(SceneParser, UnresolvableRefinementLevelIsRefused) {
   // Explicit wall spacing 0.25 m: level 2 (d = 0.125 m, r0 = 0.0625 m) would slip between wall particles.
   Json doc = full_scene();
@@ -338,6 +387,17 @@ TEST(SceneParser, OverridesEditTheDocumentBeforeValidation) {
   EXPECT_EQ(override_error("time.end"), "scene error: --set: expected key.path=value (got 'time.end')");
   EXPECT_EQ(override_error("fluid[7].spacing=1"), "scene error: --set fluid[7].spacing: index 7 is out of range (fluid has 2 elements)");
   EXPECT_EQ(override_error("time.end.x=1"), "scene error: --set time.end.x: time.end is not an object");
+}
+
+TEST(SceneParser, ADirectoryIsNotASceneFile) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path();
+  try {
+    (void)load_scene(dir);
+    FAIL();
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.what(), "scene error: " + dir.string() + ": is a directory, not a scene file");
+    EXPECT_EQ(e.exit_code(), 2);
+  }
 }
 
 TEST(SceneParser, MissingFileIsASceneError) {

@@ -263,13 +263,27 @@ void write_checkpoint(const std::filesystem::path& file, const ParticleStore<2>&
   commit_file(file);
 }
 
-CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore<2>& store) {
+std::string checkpoint_problem(const std::filesystem::path& file) {
   quiet_hdf5();
-  const Handle f(H5Fopen(file.c_str(), H5F_ACC_RDONLY, kDefault), H5Fclose, "open " + file.string());
-  const Handle g(H5Gopen2(f, kCheckpointGroup, kDefault), H5Gclose, file.string() + " is not a checkpoint");
-  if (!has_attribute(g, "format") || read_attribute<std::uint64_t>(g, "format", H5T_NATIVE_UINT64) != kCheckpointFormat) {
-    throw std::runtime_error(file.string() + ": unsupported checkpoint format");
+  const hid_t id = H5Fopen(file.c_str(), H5F_ACC_RDONLY, kDefault);
+  if (id < 0) return "not an HDF5 file";
+  const Handle f(id, H5Fclose, "open " + file.string());
+  if (H5Lexists(f, kCheckpointGroup, kDefault) <= 0) return std::string("an HDF5 file without the '") + kCheckpointGroup + "' group";
+  const Handle g(H5Gopen2(f, kCheckpointGroup, kDefault), H5Gclose, "open the checkpoint group of " + file.string());
+  if (!has_attribute(g, "format")) return "its checkpoint group has no format attribute";
+  const auto format = read_attribute<std::uint64_t>(g, "format", H5T_NATIVE_UINT64);
+  if (format != kCheckpointFormat) {
+    return "checkpoint format " + std::to_string(format) + "; this program reads format " + std::to_string(kCheckpointFormat);
   }
+  return "";
+}
+
+CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore<2>& store) {
+  if (const std::string why = checkpoint_problem(file); !why.empty()) {
+    throw std::runtime_error(file.string() + " is not a sphrefine checkpoint (" + why + ")");
+  }
+  const Handle f(H5Fopen(file.c_str(), H5F_ACC_RDONLY, kDefault), H5Fclose, "open " + file.string());
+  const Handle g(H5Gopen2(f, kCheckpointGroup, kDefault), H5Gclose, "open the checkpoint group of " + file.string());
   CheckpointState s;
   s.time = read_attribute<double>(g, "time", H5T_NATIVE_DOUBLE);
   s.step = read_attribute<std::uint64_t>(g, "step", H5T_NATIVE_UINT64);

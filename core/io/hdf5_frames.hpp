@@ -67,6 +67,10 @@ struct CheckpointState {
 /// Writes every field of every non-ghost particle and the state, atomically.
 void write_checkpoint(const std::filesystem::path& file, const ParticleStore<2>& store, const CheckpointState& state);
 
+/// Why `file` is not a checkpoint this program reads ("" when it is one: an HDF5 file with the checkpoint
+/// group in the current format). Reads only the file's header.
+std::string checkpoint_problem(const std::filesystem::path& file);
+
 /// Reads a checkpoint into `store` (replacing its particles and next id). Throws std::runtime_error.
 CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore<2>& store);
 

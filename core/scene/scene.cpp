@@ -1,9 +1,14 @@
 // Quantities derived from a scene (spacings, sound speed, particle estimates) and the enumerations' names.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <limits>
 #include <numbers>
 
+#include "core/cell_grid.hpp"
 #include "core/particle_store.hpp"
+#include "core/scene/scene_builder.hpp"
 #include "core/scene/scene_parser.hpp"
 
 namespace sph::scene {
@@ -58,17 +63,41 @@ double wall_spacing(const Scene& s) {
   return finest_spacing(s) / 2;
 }
 
-double estimated_particles(const Scene& s) {
+double estimated_particles(const Scene& s) { return estimated_fluid_particles(s) + estimated_wall_particles(s); }
+
+double estimated_fluid_particles(const Scene& s) {
   double fluid = 0.0;
   for (const auto& f : s.fluid) fluid += estimated_particles(f);
-  if (s.effects.static_refinement) fluid *= 4.0;
-  double walls = 0.0;
-  if (s.effects.lennard_jones_wall) {
-    double extent = 2.0 * (s.container.box.hi - s.container.box.lo).sum();
-    for (const auto& o : s.obstacles) extent += 2.0 * (o.hi - o.lo).sum();
-    walls = extent / wall_spacing(s);
-  }
-  return fluid + walls;
+  return s.effects.static_refinement ? 4.0 * fluid : fluid;
+}
+
+double wall_length(const Scene& s) {
+  double length = 0.0;
+  for (const Wall2& w : solver_settings(s).geometry.walls()) length += w.length();
+  return length;
+}
+
+double estimated_wall_particles(const Scene& s) {
+  if (!s.effects.lennard_jones_wall) return 0.0;
+  // Along each wall, one particle every wall spacing from end to end: ceil(length / spacing) + 1 of them.
+  const double walls = static_cast<double>(solver_settings(s).geometry.walls().size());
+  return wall_length(s) / wall_spacing(s) + 2.0 * walls;
+}
+
+double estimated_ghost_particles(const Scene& s) {
+  if (!s.effects.ghost_walls) return 0.0;
+  // A wall mirrors the particles within 2 h = 2 h_factor d of it (and projecting onto it); on the starting
+  // lattices that is at most ceil(2 h_factor) rows of length / d + 1 particles, d the finest starting lattice
+  // spacing (halved by a static refinement pass). A particle near two perpendicular walls also gets a corner
+  // image: at most rows^2 of them at each corner, and there are no more corners than walls. No particle has
+  // more than GhostBuilder::kMaxGhosts images.
+  double d = std::numeric_limits<double>::infinity();
+  for (const auto& f : s.fluid) d = std::min(d, f.lattice_spacing());
+  if (s.effects.static_refinement) d /= 2.0;
+  const double rows = std::ceil(2.0 * s.h_factor);
+  double bound = 0.0;
+  for (const Wall2& w : solver_settings(s).geometry.walls()) bound += (w.length() / d + 1.0) * rows + rows * rows;
+  return std::min(bound, GhostBuilder::kMaxGhosts * estimated_fluid_particles(s));
 }
 
 double lennard_jones_strength(const Scene& s) {
@@ -76,6 +105,64 @@ double lennard_jones_strength(const Scene& s) {
   const LennardJonesWall& w = *s.effects.lennard_jones_wall;
   if (w.strength) return *w.strength;
   return 5.0 * gravity_magnitude(s) * w.reference_height.value_or(0.0);
+}
+
+MemoryEstimate estimated_memory(const Scene& s, int threads) {
+  // The store holds the fluid, ghost and wall particles, and each of them costs, in bytes:
+  //  - the store's fields (ParticleStore::bytes_per_particle()) twice: every Field keeps a gather scratch as
+  //    large as itself once the store has been reordered (every step reorders it);
+  //  - the fields a third time: the watchdog's rollback copy of the store;
+  //  - the step's neighbour workspace (Simulation::prepare_neighbours): expansion offsets, expansion and
+  //    gather sources (three indices), their image numbers (two bytes) and the expanded positions.
+  // The cell grid adds its order, keys and cells (CellGrid::bytes_bound: cells at the full budget).
+  // This is the start. Dynamic refinement splits particles into four as the run goes (up to the scene's
+  // max_level) and grows all of it; outputs take a field's worth more while they write.
+  constexpr double per_particle = 3.0 * ParticleStore<2>::bytes_per_particle() + 3.0 * sizeof(std::uint32_t) +
+                                  2.0 * sizeof(std::int8_t) + sizeof(Vec<2>);
+  const double n = estimated_fluid_particles(s) + estimated_ghost_particles(s) + estimated_wall_particles(s);
+  const auto grid = static_cast<double>(CellGrid<2>::bytes_bound(static_cast<std::size_t>(std::min(n, 1e15)), threads));
+  return {n, n * per_particle + grid};
+}
+
+namespace {
+
+/// 31096143 -> "31,096,143".
+std::string grouped(double x) {
+  const std::string digits = std::to_string(static_cast<unsigned long long>(std::llround(std::max(0.0, x))));
+  std::string out;
+  for (std::size_t k = 0; k < digits.size(); ++k) {
+    if (k > 0 && (digits.size() - k) % 3 == 0) out += ',';
+    out += digits[k];
+  }
+  return out;
+}
+
+/// x with one decimal ("13.4") or none ("454").
+std::string decimals(double x, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, x);
+  return buf;
+}
+
+/// "13.4 GiB (31,096,143 particles at ~454 B each)".
+std::string amount(const MemoryEstimate& m) {
+  const double each = m.particles > 0.0 ? m.bytes / m.particles : 0.0;
+  return memory_text(m.bytes) + " (" + grouped(m.particles) + " particles at ~" +
+         (each >= 1000.0 ? decimals(each / 1000.0, 1) + " kB" : decimals(each, 0) + " B") + " each)";
+}
+
+}  // namespace
+
+std::string memory_text(double bytes) {
+  constexpr double mib = 1024.0 * 1024.0, gib = 1024.0 * mib;
+  return bytes >= gib ? decimals(bytes / gib, 1) + " GiB" : decimals(bytes / mib, 0) + " MiB";
+}
+
+std::string to_string(const MemoryEstimate& m) { return "about " + amount(m); }
+
+std::string memory_refusal(const MemoryEstimate& need, double available_bytes) {
+  if (need.bytes <= available_bytes) return "";
+  return "the scene needs about " + amount(need) + " but " + memory_text(available_bytes) + " are available";
 }
 
 const char* to_string(Shape v) { return v == Shape::rectangle ? "rectangle" : "circle"; }

@@ -186,6 +186,31 @@ double lennard_jones_strength(const Scene& s);
 double estimated_particles(const Scene& s);
 /// The lattice points of one fluid region at its lattice spacing (an upper estimate for a circle).
 double estimated_particles(const FluidRegion& f);
+/// The fluid particles the scene starts with: every region's lattice, quadrupled by a static refinement pass.
+double estimated_fluid_particles(const Scene& s);
+/// The Lennard-Jones wall particles (0 without them), a little above the count placed along the walls.
+double estimated_wall_particles(const Scene& s);
+/// An upper bound on the ghost particles at the start (0 without ghost walls), from the walls' lengths.
+double estimated_ghost_particles(const Scene& s);
+/// The total length of the walls (m): the container's bottom and sides (and top when closed), every
+/// obstacle's four faces.
+double wall_length(const Scene& s);
+
+/// What a run of the scene holds in memory at its start: particles (fluid, ghosts, walls) and bytes.
+struct MemoryEstimate {
+  double particles = 0.0;
+  double bytes = 0.0;
+};
+/// About how much memory a run of the scene needs at its start, with `threads` threads, before anything is
+/// allocated (scene.cpp lists what it counts). Dynamic refinement can add particles later; this is the start.
+MemoryEstimate estimated_memory(const Scene& s, int threads);
+/// "about 13.4 GiB (31,096,143 particles at ~454 B each)".
+std::string to_string(const MemoryEstimate& m);
+/// A byte count in GiB (or MiB below one GiB): "13.4 GiB".
+std::string memory_text(double bytes);
+/// The refusal when a run needing `need` does not fit in `available_bytes` ("" when it fits):
+/// "the scene needs about 41.3 GiB (...) but 22.8 GiB are available".
+std::string memory_refusal(const MemoryEstimate& need, double available_bytes);
 /// The largest level-0 spacing of the fluid regions (default probe band).
 double coarsest_spacing(const Scene& s);
 

@@ -399,6 +399,7 @@ Json parse_json_text(const std::string& text, const std::string& source) {
 
 Json read_json_file(const std::filesystem::path& file) {
   std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) fail(file.string(), "is a directory, not a scene file");
   if (!std::filesystem::is_regular_file(file, ec)) fail(file.string(), "no such scene file");
   std::ifstream in(file, std::ios::binary);
   if (!in) fail(file.string(), "cannot read the scene file");

@@ -54,6 +54,29 @@ Rect bounds(const FluidRegion& f) {
   return Rect{f.centre - Vec<2>::Constant(f.radius), f.centre + Vec<2>::Constant(f.radius)};
 }
 
+std::string point(const Vec<2>& p) { return "[" + num(p[0]) + ", " + num(p[1]) + "]"; }
+
+/// A region as the scene gives it, for messages: "rectangle [0, 0] .. [1, 2]", "circle at [8, 7] radius 1".
+std::string describe(const FluidRegion& f) {
+  if (f.shape == Shape::rectangle) return "rectangle " + point(f.rect.lo) + " .. " + point(f.rect.hi);
+  return "circle at " + point(f.centre) + " radius " + num(f.radius);
+}
+
+/// Whether two fluid regions would share particles. Regions may touch: a rectangle's particles lie d/2 inside
+/// its edges, so two rectangles sharing an edge tile without a common point, and a circle touching a
+/// rectangle keeps its particles outside the rectangle's. Two circles may not touch: each lattice reaches its
+/// circle, so both can hold the point of contact. `t` absorbs rounding in coordinates given as decimals.
+bool regions_overlap(const FluidRegion& a, const FluidRegion& b, double t) {
+  if (a.shape == Shape::rectangle && b.shape == Shape::rectangle) {
+    return a.rect.lo[0] < b.rect.hi[0] - t && b.rect.lo[0] < a.rect.hi[0] - t && a.rect.lo[1] < b.rect.hi[1] - t &&
+           b.rect.lo[1] < a.rect.hi[1] - t;
+  }
+  if (a.shape == Shape::circle && b.shape == Shape::circle) return (a.centre - b.centre).norm() < a.radius + b.radius + t;
+  const FluidRegion& circle = a.shape == Shape::circle ? a : b;
+  const FluidRegion& rect = a.shape == Shape::circle ? b : a;
+  return distance_to_rect(circle.centre, rect.rect) < circle.radius - t;
+}
+
 void validate_region(const Scene& s, const FluidRegion& f, const std::string& path) {
   if (f.shape == Shape::rectangle) {
     valid_rect(f.rect, path);
@@ -191,6 +214,19 @@ void validate_scene(const Scene& s) {
     total += estimated_particles(s.fluid[k]);
   }
   if (total > kMaxParticles) fail("fluid", "the regions would create about " + num(total) + " particles (limit " + num(kMaxParticles) + ")");
+  // Overlapping regions would fill their common part twice (two particles, twice the mass, at each point).
+  const double tol = kTol * std::max(1.0, (s.container.box.hi - s.container.box.lo).cwiseAbs().maxCoeff());
+  for (std::size_t k = 0; k < s.fluid.size(); ++k) {
+    for (std::size_t j = 0; j < k; ++j) {
+      if (!regions_overlap(s.fluid[j], s.fluid[k], tol)) continue;
+      const bool circles = s.fluid[j].shape == Shape::circle && s.fluid[k].shape == Shape::circle;
+      fail(element("fluid", k), std::string(circles ? "overlaps or touches " : "overlaps ") + element("fluid", j) + " (" +
+                                    element("fluid", k) + ": " + describe(s.fluid[k]) + "; " + element("fluid", j) +
+                                    ": " + describe(s.fluid[j]) + "); fluid regions must not overlap" +
+                                    (circles ? " and circles must not touch" : "") +
+                                    ", or the common part would hold the particles of both");
+    }
+  }
 
   if (e.refinement) {
     int start = 0;
@@ -227,9 +263,7 @@ void validate_scene(const Scene& s) {
                " m exceeds the repulsion range r0 = r0_factor * d = " + num(r0) + " m of its particles (d = " + num(d) +
                (w.spacing ? " m); lower the refinement level or the wall spacing" : " m); raise r0_factor to 0.5 or more"));
     }
-    double extent = 2.0 * (s.container.box.hi - s.container.box.lo).sum();
-    for (const auto& o : s.obstacles) extent += 2.0 * (o.hi - o.lo).sum();
-    if (extent / ws > kMaxParticles) fail(p + ".spacing", "would create more than " + num(kMaxParticles) + " wall particles");
+    if (estimated_wall_particles(s) > kMaxParticles) fail(p + ".spacing", "would create more than " + num(kMaxParticles) + " wall particles");
   }
 
   const Time& t = s.time;
