@@ -269,8 +269,7 @@ void Runner::write_summary(const RunSummary& r, const FailureReport* failure) {
   j["rows"] = r.rows;
   j["frames"] = r.frames;
   if (failure) {
-    static constexpr const char* kinds[] = {"not_finite", "density", "left_domain"};
-    j["failure"] = {{"kind", kinds[static_cast<int>(failure->kind)]},
+    j["failure"] = {{"kind", to_string(failure->kind)},
                     {"step", failure->step},
                     {"time", failure->time},
                     {"particle", failure->id},
