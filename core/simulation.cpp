@@ -98,6 +98,7 @@ StepInfo Simulation::step(double dt_cap) {
   if (watch) {
     last_good_.assign_from(store_);  // reuses capacity: no allocation once the sizes are stable
     last_good_limits_ = limits_;
+    last_good_removed_ = removed_;
   }
   const double half = 0.5 * dt;
   const TaitEquationOfState eos = settings_.eos;
@@ -113,6 +114,7 @@ StepInfo Simulation::step(double dt_cap) {
       s.p[i] = eos.pressure(s.rho[i]);
     });
   }
+  if (settings_.geometry.outflow == Outflow::remove) removed_.add(remove_outflow(store_, settings_.geometry));
   // The drift can already have produced a non-finite position, which the grid refuses: with the watchdog on,
   // that is reported (and undone) like any other failure of the step, naming the particle.
   std::string step_error;
@@ -151,6 +153,7 @@ StepInfo Simulation::step(double dt_cap) {
       // Only the grid is rebuilt for the restored particles (same order and ghosts; no rate re-evaluation).
       std::swap(store_, last_good_);
       limits_ = last_good_limits_;
+      removed_ = last_good_removed_;
       prepare_neighbours();
       throw SimulationFailure(report);
     }
@@ -179,6 +182,8 @@ Diagnostics Simulation::diagnostics() const {
   d.time = time_;
   d.step = step_;
   d.dt = dt_;
+  d.removed = removed_.particles;
+  d.removed_mass = removed_.mass.value();
   return d;
 }
 

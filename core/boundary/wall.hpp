@@ -4,6 +4,7 @@
 // helpers that build them, so a sloped segment can come later.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -40,12 +41,17 @@ struct Box2 {
   }
 };
 
-/// The solid geometry of a scene: a container (fluid inside, open at the top if `open_top`) and
-/// rectangular obstacles (fluid outside).
+/// What happens to fluid that leaves through an open top (over the rim): the watchdog stops the run, or the
+/// step removes it (core/boundary/outflow.hpp), counting it and its mass.
+enum class Outflow : std::uint8_t { stop, remove };
+
+/// The solid geometry of a scene: a container (fluid inside, open at the top if `open_top`, with what happens to
+/// fluid leaving through it) and rectangular obstacles (fluid outside).
 struct Geometry2 {
   Box2 container{Vec<2>(0, 0), Vec<2>(1, 1)};
   bool open_top = true;
   std::vector<Box2> obstacles;
+  Outflow outflow = Outflow::stop;
 
   /// Every wall segment with its normal into the fluid.
   std::vector<Wall2> walls() const {
