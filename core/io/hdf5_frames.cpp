@@ -256,6 +256,9 @@ void write_checkpoint(const std::filesystem::path& file, const ParticleStore<2>&
     write_attribute(g, "initial_mass", H5T_NATIVE_DOUBLE, state.initial_mass);
     write_attribute(g, "initial_momentum_x", H5T_NATIVE_DOUBLE, state.initial_momentum_x);
     write_attribute(g, "initial_momentum_y", H5T_NATIVE_DOUBLE, state.initial_momentum_y);
+    write_attribute(g, "removed_particles", H5T_NATIVE_UINT64, state.removed_particles);
+    write_attribute(g, "removed_mass", H5T_NATIVE_DOUBLE, state.removed_mass);
+    write_attribute(g, "removed_mass_compensation", H5T_NATIVE_DOUBLE, state.removed_mass_compensation);
     write_attribute(g, "particles", H5T_NATIVE_UINT64, static_cast<std::uint64_t>(keep.size()));
     write_string_attribute(g, "scene", state.scene);
     store.for_each_field([&](const auto& field) { write_dataset(g, std::string(field.name()), gathered(field, keep)); });
@@ -283,6 +286,12 @@ CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore
   s.initial_mass = read_attribute<double>(g, "initial_mass", H5T_NATIVE_DOUBLE);
   s.initial_momentum_x = read_attribute<double>(g, "initial_momentum_x", H5T_NATIVE_DOUBLE);
   s.initial_momentum_y = read_attribute<double>(g, "initial_momentum_y", H5T_NATIVE_DOUBLE);
+  // Absent from checkpoints written before outflow removal existed: nothing was removed then.
+  if (has_attribute(g, "removed_particles")) {
+    s.removed_particles = read_attribute<std::uint64_t>(g, "removed_particles", H5T_NATIVE_UINT64);
+    s.removed_mass = read_attribute<double>(g, "removed_mass", H5T_NATIVE_DOUBLE);
+    s.removed_mass_compensation = read_attribute<double>(g, "removed_mass_compensation", H5T_NATIVE_DOUBLE);
+  }
   s.scene = read_string_attribute(g, "scene");
   const auto n = read_attribute<std::uint64_t>(g, "particles", H5T_NATIVE_UINT64);
   store.clear();

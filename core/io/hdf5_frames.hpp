@@ -61,6 +61,9 @@ struct CheckpointState {
   double initial_mass = 0.0;      // the run's state at t = 0, for the drift in the summary
   double initial_momentum_x = 0.0;
   double initial_momentum_y = 0.0;
+  std::uint64_t removed_particles = 0;     // fluid removed through the open top so far (Simulation::removed)
+  double removed_mass = 0.0;               // its mass: the compensated sum's value and compensation, so a
+  double removed_mass_compensation = 0.0;  // resumed run adds later removals exactly as the uninterrupted one
   std::string scene;             // the scene (JSON) the run was started from
 };
 
