@@ -45,7 +45,7 @@ void print_summary(const scene::Scene& s, const scene::RunSummary& r, const std:
   std::printf("  particle-steps/s   %.4g\n", pps);
   std::printf("  fluid per level    %s (walls %zu)\n", levels_text(r.final.per_level).c_str(), r.final.walls);
   if (r.final.removed > 0) {
-    std::printf("  removed            %llu fluid particles through the open top, %.6g kg (%.3g %% of M0)\n",
+    std::printf("  removed            %llu fluid particles through the open top, %.6g kg/m (%.3g %% of M0)\n",
                 static_cast<unsigned long long>(r.final.removed), r.final.removed_mass,
                 r.initial_mass > 0.0 ? 100.0 * r.final.removed_mass / r.initial_mass : 0.0);
   }

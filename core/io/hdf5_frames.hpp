@@ -3,8 +3,9 @@
 //
 // A frame file holds one group (named like "frame_000012") with one dataset per particle field (named
 // after the field: "position" N x 2, "density" N, "level" N, ...) for every particle except ghosts, in
-// store order, and the attributes time (s), step, frame and particles. A checkpoint file holds group
-// "checkpoint" with every field and the whole state needed to continue bitwise identically. Every file
+// store order, each with a `units` attribute (the field's unit, ParticleStore), and the attributes time,
+// time_units ("s"), step, frame and particles. A checkpoint file holds group "checkpoint" with every field
+// (with units too) and the whole state needed to continue bitwise identically. Every file
 // is written under a temporary name and renamed when complete (core/io/atomic_file.hpp).
 #include <cstdint>
 #include <filesystem>
