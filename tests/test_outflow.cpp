@@ -278,6 +278,33 @@ TEST(Outflow, WithStopTheSplashEndsTheRunWithTheOpenTopMessage) {
   EXPECT_EQ(summary.at("removed_particles").get<std::uint64_t>(), 0u);
 }
 
+TEST(Outflow, AStoppedRunResumedWithRemoveContinuesAsARunThatRemovedFromTheStart) {
+  // The way on from the open-top message: --resume the checkpoint of the last good state with outflow "remove".
+  // Up to that state neither run had removed anything, so the resumed run ends bitwise where the run that
+  // removed from the start ends.
+  TempFolder tmp;
+  omp_set_num_threads(1);
+  const fs::path out = tmp.path() / "run";
+  {
+    scene::Runner stopped(thrown_scene("stop"), scene::RunOptions{out, std::nullopt, std::nullopt});
+    try {
+      stopped.run();
+      FAIL() << "the run completed";
+    } catch (const scene::RunFailure& e) {
+      EXPECT_NE(std::string(e.what()).find("--resume and --set container.outflow=remove"), std::string::npos)
+          << e.what();
+    }
+  }
+  scene::Runner resumed(thrown_scene("remove"), scene::RunOptions{out, out / "checkpoint.h5", std::nullopt});
+  resumed.run();
+  scene::Runner from_start(thrown_scene("remove"), scene::RunOptions{});
+  from_start.run();
+  EXPECT_EQ(resumed.simulation().step_count(), from_start.simulation().step_count());
+  expect_bitwise_equal(resumed.simulation().store(), from_start.simulation().store());
+  EXPECT_EQ(resumed.simulation().removed().particles, kThrown);
+  EXPECT_EQ(resumed.simulation().removed().mass.value(), from_start.simulation().removed().mass.value());
+}
+
 TEST(Outflow, RemovalIsBitwiseIdenticalAtOneAndTwoThreadsAndOnResume) {
   TempFolder tmp;
   const int threads = omp_get_max_threads();

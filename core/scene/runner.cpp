@@ -35,10 +35,13 @@ bool due(double t, std::uint64_t index, double interval) {
 
 double frame_interval(const Scene& s) { return s.output.frame_interval.value_or(s.time.interval()); }
 
-/// The scene with what a resumed run may change (end time, outputs, probes, names) left out.
+/// The scene with what a resumed run may change (end time, outputs, probes, names, outflow) left out. The outflow
+/// may change because a run stopped by fluid leaving over the rim (outflow "stop") has removed nothing up to its
+/// checkpoint, exactly as a run with "remove" would have: resumed with "remove", it continues as that run.
 Json physics_of(const Scene& s) {
   Json j = scene_to_json(s);
   for (const char* key : {"name", "description", "time", "probes", "output"}) j.erase(key);
+  j["container"].erase("outflow");
   return j;
 }
 
@@ -59,7 +62,7 @@ Runner::Runner(Scene scene, RunOptions options)
       throw SceneError("--resume", "the checkpoint does not hold a readable scene");
     }
     if (physics_of(original) != physics_of(scene_)) {
-      throw SceneError("--resume", "the checkpoint was written by a different scene (only time, probes and output may change)");
+      throw SceneError("--resume", "the checkpoint was written by a different scene (only time, probes, output and container.outflow may change)");
     }
     // The first step after the checkpoint is the one it recorded; with a changed time.cfl (the way on after
     // a watchdog stop) or dt_max it follows the new settings at once (dt = cfl * limit, capped by dt_max).
@@ -308,7 +311,9 @@ void Runner::fail(const FailureReport& report) {
                   static_cast<unsigned long long>(step), sim_.time());
     where = buf;
     if (scene_.output.frames) where += (options_.folder / frames_.back().file).string() + " and ";
-    where += files_.checkpoint().string() + " (continue with --resume and a smaller time.cfl).";
+    where += files_.checkpoint().string() + (report.kind == FailureKind::left_open_top
+                                                 ? " (continue with --resume and --set container.outflow=remove)."
+                                                 : " (continue with --resume and a smaller time.cfl).");
   }
   throw RunFailure(report.message() + "." + where, report);
 }
