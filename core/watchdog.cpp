@@ -73,8 +73,8 @@ bool find_failure(const ParticleStore<2>& store, const Geometry2& geometry, doub
       break;
     case 2:
       out.kind = FailureKind::left_domain;
-      out.quantity = "the particle left the domain through a wall (outside the container below its rim, or inside an "
-                     "obstacle)";
+      out.quantity = "the particle left the domain through a wall (the container's floor, a side below the rim or a "
+                     "closed top, or into an obstacle)";
       out.cause = "wall penetration: walls too weak for the impact speed (enable the Lennard-Jones wall or ghost "
                   "walls, raise its strength) or a time step too large";
       break;
