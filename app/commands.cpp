@@ -52,7 +52,12 @@ void print_summary(const scene::Scene& s, const scene::RunSummary& r, const std:
   std::printf("  steps              %llu (this run)\n", static_cast<unsigned long long>(r.steps));
   std::printf("  particle-steps/s   %.4g\n", pps);
   std::printf("  fluid per level    %s (walls %zu)\n", levels_text(r.final.per_level).c_str(), r.final.walls);
-  std::printf("  mass drift         %+.3e (relative)\n", r.mass_drift);
+  if (r.final.removed > 0) {
+    std::printf("  removed            %llu fluid particles through the open top, %.6g kg/m (%.3g %% of M0)\n",
+                static_cast<unsigned long long>(r.final.removed), r.final.removed_mass,
+                r.initial_mass > 0.0 ? 100.0 * r.final.removed_mass / r.initial_mass : 0.0);
+  }
+  std::printf("  mass drift         %+.3e (relative, removed fluid counted)\n", r.mass_drift);
   std::printf("  momentum change    |P - P0| = %.3e kg m/s (P = [%.3e, %.3e])\n", r.momentum_change,
               r.final.momentum[0], r.final.momentum[1]);
   if (!folder.empty()) {

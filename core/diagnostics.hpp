@@ -27,6 +27,9 @@ struct Diagnostics {
   double max_density_error = 0.0;  // max |rho/rho0 - 1|
   std::size_t fluid = 0, ghosts = 0, walls = 0;
   std::vector<std::size_t> per_level;  // fluid particles per refinement level
+  // Fluid removed through the open top so far (the simulation's count, not the store's): M + removed_mass = M0.
+  std::uint64_t removed = 0;
+  double removed_mass = 0.0;
 
   double total_energy() const { return kinetic + potential + elastic; }
 };

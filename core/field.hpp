@@ -1,6 +1,6 @@
 #pragma once
-// One per-particle array of the store, with a name and a scratch buffer reused by gathers so that
-// reordering allocates nothing once the store has reached its size.
+// One per-particle array of the store, with a name, the unit of its values, and a scratch buffer reused by
+// gathers so that reordering allocates nothing once the store has reached its size.
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
@@ -24,9 +24,12 @@ template <class T>
 class Field {
  public:
   using value_type = T;
-  explicit Field(std::string_view name) : name_(name) {}
+  /// `unit`: the SI unit of the values as UDUNITS text ("m", "m/s", "kg/m^3", "Pa"; "1" for counts, ids and
+  /// labels); output writes it beside the values (the HDF5 datasets' `units` attribute).
+  Field(std::string_view name, std::string_view unit) : name_(name), unit_(unit) {}
 
   std::string_view name() const { return name_; }
+  std::string_view unit() const { return unit_; }
   std::size_t size() const { return data_.size(); }
   T* data() { return data_.data(); }
   const T* data() const { return data_.data(); }
@@ -52,6 +55,7 @@ class Field {
 
  private:
   std::string_view name_;
+  std::string_view unit_;
   std::vector<T> data_;
   std::vector<T> scratch_;
 };

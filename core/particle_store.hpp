@@ -39,22 +39,23 @@ class ParticleStore {
   static constexpr int dim = D;
   using VecD = Vec<D>;
 
-  // The fields. Adding one here (and to for_each_field) is all it takes for every operation to carry it.
-  Field<VecD> x{"position"};
-  Field<VecD> v{"velocity"};
-  Field<double> rho{"density"};
-  Field<double> p{"pressure"};
-  Field<double> m{"mass"};
-  Field<double> h{"smoothing_length"};
-  Field<double> d{"spacing"};
-  Field<std::int32_t> level{"level"};
-  Field<Kind> kind{"kind"};
-  Field<ParticleId> id{"id"};
-  Field<double> drho{"density_rate"};
-  Field<VecD> a{"acceleration"};
+  // The fields, each with its name and unit. Adding one here (and to for_each_field) is all it takes for every
+  // operation to carry it.
+  Field<VecD> x{"position", "m"};
+  Field<VecD> v{"velocity", "m/s"};
+  Field<double> rho{"density", "kg/m^3"};
+  Field<double> p{"pressure", "Pa"};
+  Field<double> m{"mass", "kg/m"};  // 2D: per metre of depth (rho0 d^2), as energies are J/m
+  Field<double> h{"smoothing_length", "m"};
+  Field<double> d{"spacing", "m"};
+  Field<std::int32_t> level{"level", "1"};
+  Field<Kind> kind{"kind", "1"};
+  Field<ParticleId> id{"id", "1"};
+  Field<double> drho{"density_rate", "kg/m^3/s"};
+  Field<VecD> a{"acceleration", "m/s^2"};
   // Integrator stage state (kick-drift-kick): velocity and density at the half step.
-  Field<VecD> vh{"velocity_half"};
-  Field<double> rhoh{"density_half"};
+  Field<VecD> vh{"velocity_half", "m/s"};
+  Field<double> rhoh{"density_half", "kg/m^3"};
 
   /// The registry: every field as a pointer to member. Adding a field above and here is all it takes for
   /// every operation (gather, compaction, expansion, copies, output, checkpoints) to carry it.

@@ -112,6 +112,7 @@ StepInfo Simulation::step(double dt_cap) {
   if (watch) {
     last_good_.prepare_copy_of(store_);  // reuses capacity: no allocation once the sizes are stable
     last_good_limits_ = limits_;
+    last_good_removed_ = removed_;
   }
   SmoothingRange hr;
   {
@@ -134,10 +135,22 @@ StepInfo Simulation::step(double dt_cap) {
         },
         [](const SmoothingRange& a, const SmoothingRange& b) { return a.merged(b); });
   }
+  // Fluid that left through an open top (container.outflow = "remove") goes now, before the neighbour search
+  // and the watchdog. A removal renumbers the particles, so the counts and range of the loop above are redone.
+  bool renumbered = false;
+  if (settings_.geometry.outflow == Outflow::remove) {
+    const RemovedFluid out = remove_outflow(store_, settings_.geometry);
+    removed_.add(out);
+    renumbered = out.particles > 0;
+  }
   // The drift can already have produced a non-finite position, which the grid refuses: with the watchdog on,
   // that is reported (and undone) like any other failure of the step, naming the particle.
   try {
-    build_neighbours(hr);
+    if (renumbered) {
+      prepare_neighbours();
+    } else {
+      build_neighbours(hr);
+    }
     limits_ = sweep_->run(store_.view(), grid_);
   } catch (const std::exception& e) {
     if (!watch) throw;
@@ -171,6 +184,7 @@ StepInfo Simulation::step(double dt_cap) {
       // Only the grid is rebuilt for the restored particles (same order and ghosts; no rate re-evaluation).
       std::swap(store_, last_good_);
       limits_ = last_good_limits_;
+      removed_ = last_good_removed_;
       prepare_neighbours();
       throw SimulationFailure(report);
     }
@@ -199,6 +213,8 @@ Diagnostics Simulation::diagnostics() const {
   d.time = time_;
   d.step = step_;
   d.dt = dt_;
+  d.removed = removed_.particles;
+  d.removed_mass = removed_.mass.value();
   return d;
 }
 

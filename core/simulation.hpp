@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/boundary/ghosts.hpp"
+#include "core/boundary/outflow.hpp"
 #include "core/cell_grid.hpp"
 #include "core/diagnostics.hpp"
 #include "core/neighbour_cells.hpp"
@@ -64,13 +65,18 @@ class Simulation {
     dt_ = dt;
   }
 
+  /// Fluid removed so far through the open top (geometry.outflow = remove); part of the state (checkpoints).
+  const RemovedFluid& removed() const { return removed_; }
+  void set_removed(const RemovedFluid& removed) { removed_ = removed; }
+
   /// Evaluates pressures, ghosts, grid and rates for the current state, and the next dt. Call once after
   /// set-up and after anything changes the particle set.
   void refresh();
 
-  /// One time step (no stages). dt is min(next dt, dt_cap). With the watchdog on, a step that produces a
+  /// One time step (no stages). dt is min(next dt, dt_cap). With outflow = remove, fluid that left through the
+  /// open top is removed after the drift (remove_outflow). With the watchdog on, a step that produces a
   /// NaN/Inf, a density error past the limit or a particle outside the domain is undone (the simulation is
-  /// back at the last good state) and SimulationFailure is thrown.
+  /// back at the last good state, removals included) and SimulationFailure is thrown.
   StepInfo step(double dt_cap = std::numeric_limits<double>::infinity());
 
   /// Steps (running the stages after each) until time() reaches t_end.
@@ -109,6 +115,7 @@ class Simulation {
   SweepLimits limits_;
   ParticleStore<2> last_good_;
   SweepLimits last_good_limits_;  // limits_ of the last good state (restored with it)
+  RemovedFluid removed_, last_good_removed_;
   // Step workspace of prepare_neighbours (reused, so a step allocates nothing once sizes settle).
   std::vector<std::uint32_t> expand_src_, expand_offsets_;
   std::vector<std::int8_t> expand_image_;

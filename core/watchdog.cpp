@@ -8,6 +8,16 @@
 
 namespace sph {
 
+const char* to_string(FailureKind kind) {
+  switch (kind) {
+    case FailureKind::not_finite: return "not_finite";
+    case FailureKind::density: return "density";
+    case FailureKind::left_domain: return "left_domain";
+    case FailureKind::left_open_top: return "left_open_top";
+  }
+  return "?";
+}
+
 std::string FailureReport::message() const {
   char buf[512];
   std::snprintf(buf, sizeof buf, "run stopped at step %llu, t = %.6g s: particle %llu at (%.6g, %.6g): %s. Likely cause: %s",
@@ -31,7 +41,7 @@ bool find_failure(const ParticleStore<2>& store, const Geometry2& geometry, doub
         !std::isfinite(store.rho[i]) || !std::isfinite(store.p[i]))
       return 0;
     if (std::abs(store.rho[i] / rho0 - 1.0) > settings.max_density_error) return 1;
-    if (!geometry.in_fluid_domain(x)) return 2;
+    if (!geometry.in_fluid_domain(x)) return geometry.left_through_open_top(x, store.vh[i]) ? 3 : 2;
     return -1;
   };
   const Hit hit = par::reduce(
@@ -61,11 +71,20 @@ bool find_failure(const ParticleStore<2>& store, const Geometry2& geometry, doub
       out.cause = "compression beyond the weakly-compressible range: the sound speed is too low for the flow "
                   "(raise c0 or the Mach factor) or the time step too large";
       break;
-    default:
+    case 2:
       out.kind = FailureKind::left_domain;
-      out.quantity = "the particle left the domain (outside the container or inside an obstacle)";
+      out.quantity = "the particle left the domain through a wall (the container's floor, a side below the rim or a "
+                     "closed top, or into an obstacle)";
       out.cause = "wall penetration: walls too weak for the impact speed (enable the Lennard-Jones wall or ghost "
                   "walls, raise its strength) or a time step too large";
+      break;
+    default:
+      out.kind = FailureKind::left_open_top;
+      std::snprintf(buf, sizeof buf, "the particle left the domain through the open top (over the rim at y = %.6g m, "
+                    "beside the container)", geometry.container.hi[1]);
+      out.quantity = buf;
+      out.cause = "a splash over the rim: raise the walls (container.hi) or let the scene remove such fluid "
+                  "(container.outflow: \"remove\")";
       break;
   }
   return true;

@@ -1,6 +1,6 @@
 #pragma once
 // The watchdog checks the state after every step: a NaN or Inf, a density error past a limit, a particle
-// leaving the domain. On failure the simulation is put back to the last good state (the step before) and a
+// leaving the domain (through a wall, or over the rim of an open top). On failure the simulation is put back to the last good state (the step before) and a
 // SimulationFailure names the step, time, particle, quantity and the likely cause.
 #include <cstdint>
 #include <stdexcept>
@@ -16,7 +16,12 @@ struct WatchdogSettings {
   double max_density_error = 0.5;  // |rho/rho0 - 1| past this stops the run
 };
 
-enum class FailureKind { not_finite, density, left_domain };
+/// left_domain: through a wall (or into an obstacle); left_open_top: over the rim of an open container (a splash,
+/// not a wall failure; a scene can remove such fluid with container.outflow = "remove").
+enum class FailureKind { not_finite, density, left_domain, left_open_top };
+
+/// The kind's name in run.json ("not_finite", "density", "left_domain", "left_open_top").
+const char* to_string(FailureKind kind);
 
 struct FailureReport {
   FailureKind kind = FailureKind::not_finite;

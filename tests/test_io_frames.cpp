@@ -2,9 +2,11 @@
 // XDMF's dataset paths and shapes match the HDF5 files, checkpoints restore the store exactly, and writes
 // leave no temporary file behind.
 #include <gtest/gtest.h>
+#include <hdf5.h>
 #include <omp.h>
 
 #include <filesystem>
+#include <map>
 #include <regex>
 #include <string>
 #include <unistd.h>
@@ -87,6 +89,68 @@ TEST(IoFrames, EveryFieldReadsBackAsWrittenWithoutGhosts) {
     ++fields;
   });
   EXPECT_EQ(fields, 14);
+}
+
+/// A string attribute of an HDF5 object ("<none>" when absent), read with the HDF5 API directly.
+std::string string_attribute(hid_t object, const char* name) {
+  if (H5Aexists(object, name) <= 0) return "<none>";
+  const hid_t attr = H5Aopen(object, name, H5P_DEFAULT);
+  const hid_t type = H5Aget_type(attr);
+  std::string value(H5Tget_size(type), '\0');
+  const hid_t mem = H5Tcopy(H5T_C_S1);
+  H5Tset_size(mem, value.size());
+  if (H5Aread(attr, mem, value.data()) < 0) value = "<unreadable>";
+  H5Tclose(mem);
+  H5Tclose(type);
+  H5Aclose(attr);
+  while (!value.empty() && value.back() == '\0') value.pop_back();
+  return value;
+}
+
+/// Every dataset of a group (whatever its name: not only the fields the writer knows) with its units attribute.
+std::map<std::string, std::string> units_of_every_dataset(const fs::path& file, const std::string& group,
+                                                          std::string* time_units) {
+  std::map<std::string, std::string> out;
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  const hid_t g = H5Gopen2(f, group.c_str(), H5P_DEFAULT);
+  H5G_info_t info;
+  H5Gget_info(g, &info);
+  for (hsize_t k = 0; k < info.nlinks; ++k) {
+    char name[256];
+    H5Lget_name_by_idx(g, ".", H5_INDEX_NAME, H5_ITER_INC, k, name, sizeof name, H5P_DEFAULT);
+    const hid_t set = H5Dopen2(g, name, H5P_DEFAULT);
+    out[name] = string_attribute(set, "units");
+    H5Dclose(set);
+  }
+  *time_units = string_attribute(g, "time_units");
+  H5Gclose(g);
+  H5Fclose(f);
+  return out;
+}
+
+TEST(IoFrames, EveryDatasetCarriesItsUnits) {
+  TempFolder tmp;
+  Simulation sim = small_dam();
+  const std::map<std::string, std::string> expected{
+      {"position", "m"},       {"velocity", "m/s"},         {"density", "kg/m^3"},    {"pressure", "Pa"},
+      {"mass", "kg/m"},        {"smoothing_length", "m"},   {"spacing", "m"},         {"level", "1"},
+      {"kind", "1"},           {"id", "1"},                 {"density_rate", "kg/m^3/s"},
+      {"acceleration", "m/s^2"}, {"velocity_half", "m/s"}, {"density_half", "kg/m^3"}};
+  std::string time_units;
+  const fs::path frame = tmp.path() / "frame.h5";
+  (void)io::write_frame(frame, "frame_000000", sim.store(), sim.time(), sim.step_count(), 0, {});
+  EXPECT_EQ(units_of_every_dataset(frame, "frame_000000", &time_units), expected);
+  EXPECT_EQ(time_units, "s");
+  // A frame of a few fields: the same units for those.
+  (void)io::write_frame(frame, "g", sim.store(), 0.0, 0, 0, {"pressure", "level"});
+  EXPECT_EQ(units_of_every_dataset(frame, "g", &time_units),
+            (std::map<std::string, std::string>{{"position", "m"}, {"pressure", "Pa"}, {"level", "1"}}));
+  // Checkpoints too.
+  io::CheckpointState state;
+  state.scene = "{}";
+  (void)io::write_checkpoint(tmp.path() / "checkpoint.h5", sim.store(), state);
+  EXPECT_EQ(units_of_every_dataset(tmp.path() / "checkpoint.h5", "checkpoint", &time_units), expected);
+  EXPECT_EQ(time_units, "s");
 }
 
 TEST(IoFrames, SelectedFieldsAlwaysIncludePosition) {

@@ -55,6 +55,7 @@ void expect_same_settings(const SolverSettings& a, const SolverSettings& b) {
   EXPECT_EQ(a.geometry.container.lo, b.geometry.container.lo);
   EXPECT_EQ(a.geometry.container.hi, b.geometry.container.hi);
   EXPECT_EQ(a.geometry.open_top, b.geometry.open_top);
+  EXPECT_EQ(a.geometry.outflow, b.geometry.outflow);
   EXPECT_EQ(a.cfl, b.cfl);
   EXPECT_EQ(a.dt_max, b.dt_max);
 }

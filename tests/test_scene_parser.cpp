@@ -95,6 +95,29 @@ TEST(SceneParser, RoundTripIsIdentity) {
   EXPECT_EQ(scene_from_json(parse_json_text(j.dump(2), "text")), s);
 }
 
+TEST(SceneParser, OutflowIsStopOrRemoveAndRemoveNeedsAnOpenTop) {
+  Json doc = full_scene();
+  EXPECT_EQ(scene_from_json(doc).container.outflow, sph::Outflow::stop) << "the default";
+  doc["container"]["open_top"] = true;
+  doc["container"]["outflow"] = "remove";
+  const Scene s = scene_from_json(doc);
+  EXPECT_EQ(s.container.outflow, sph::Outflow::remove);
+  const Json j = scene_to_json(s);
+  EXPECT_EQ(j.at("container").at("outflow"), "remove") << "the writer keeps it";
+  EXPECT_EQ(scene_from_json(j), s);
+  EXPECT_EQ(scene_from_json(parse_json_text(j.dump(2), "text")), s);
+  doc["container"]["outflow"] = "drain";
+  EXPECT_EQ(error_of(doc), "scene error: container.outflow: must be one of: stop, remove (got 'drain')");
+  doc["container"]["outflow"] = 1;
+  EXPECT_EQ(error_of(doc), "scene error: container.outflow: must be a string (got an integer)");
+  doc["container"]["outflow"] = "remove";
+  doc["container"]["open_top"] = false;
+  EXPECT_EQ(error_of(doc), "scene error: container.outflow: \"remove\" needs an open top (open_top: true): a closed "
+                           "container has no opening to leave through");
+  doc["container"]["outflow"] = "stop";
+  EXPECT_EQ(error_of(doc), "");
+}
+
 TEST(SceneParser, EveryCaseFileValidatesAndRoundTrips) {
   int n = 0;
   for (const auto& entry : std::filesystem::recursive_directory_iterator(kCases)) {

@@ -189,13 +189,53 @@ TEST(Watchdog, ParticleLeavingTheDomainIsCaught) {
   EXPECT_GT(sim.step_count(), 2u);
   EXPECT_GT(r.position[0], 10.0) << "the report gives the position outside the container";
   EXPECT_NE(r.quantity.find("left the domain"), std::string::npos) << r.quantity;
-  EXPECT_NE(r.cause.find("wall"), std::string::npos) << r.cause;
+  EXPECT_NE(r.quantity.find("through a wall"), std::string::npos) << r.quantity;
+  EXPECT_EQ(r.quantity.find("open top"), std::string::npos) << r.quantity;
+  EXPECT_NE(r.cause.find("wall penetration"), std::string::npos) << r.cause;
+  EXPECT_EQ(std::string(to_string(r.kind)), "left_domain");
   // Restored: every fluid particle is back inside.
   for (std::size_t i = 0; i < sim.store().size(); ++i) {
     if (sim.store().kind[i] == Kind::fluid) {
       EXPECT_TRUE(geometry.in_fluid_domain(sim.store().x[i]));
     }
   }
+}
+
+TEST(Watchdog, ParticleFlyingOverTheOpenTopIsNotCalledWallPenetration) {
+  // The same open box (rim at y = 10 m), a block thrown up and to the right at (8, 20) m/s from just below the
+  // rim: it is above the rim (still in the domain) before it is beyond the right side, so it leaves over the
+  // top of the right wall, as the drop at 30 m/s splashes over its container's rim.
+  Simulation sim = block_in_open_box(Vec<2>(6, 8), Vec<2>(9, 9.5), Vec<2>(8, 20), 200.0);
+  const FailureReport r = expect_failure(sim, FailureKind::left_open_top, 100000);
+  EXPECT_GT(r.position[0], 10.0);
+  EXPECT_GT(r.position[1], 10.0) << "beside the container, above its rim";
+  EXPECT_NE(r.quantity.find("through the open top"), std::string::npos) << r.quantity;
+  EXPECT_NE(r.quantity.find("y = 10 m"), std::string::npos) << "names the rim: " << r.quantity;
+  EXPECT_EQ(r.cause.find("wall penetration"), std::string::npos) << r.cause;
+  EXPECT_NE(r.cause.find("splash over the rim"), std::string::npos) << r.cause;
+  EXPECT_NE(r.cause.find("container.outflow"), std::string::npos) << "names the way out: " << r.cause;
+  EXPECT_EQ(std::string(to_string(r.kind)), "left_open_top");
+}
+
+TEST(Watchdog, OpenTopAndWallAreToldApartByWhereThePathCrossedTheSide) {
+  Geometry2 g;
+  g.container = {Vec<2>(0, 0), Vec<2>(10, 10)};
+  g.obstacles.push_back({Vec<2>(4, 2), Vec<2>(6, 4)});
+  g.open_top = true;
+  const Vec<2> right(1, 0), down_right(1, -2);
+  EXPECT_TRUE(g.left_through_open_top(Vec<2>(10.01, 10.5), right)) << "beside the container above the rim";
+  EXPECT_TRUE(g.left_through_open_top(Vec<2>(-0.01, 12.0), -right)) << "the left side too";
+  // Over the rim and down within one step: 0.01 m beyond the side, 0.01 m below the rim, falling at twice its
+  // sideways speed, so it crossed the side line at y = 10.01, above the rim.
+  EXPECT_TRUE(g.left_through_open_top(Vec<2>(10.01, 9.99), down_right));
+  // The same point reached flatter crossed the wall itself (at y = 9.995).
+  EXPECT_FALSE(g.left_through_open_top(Vec<2>(10.01, 9.99), Vec<2>(1, -0.5)));
+  EXPECT_FALSE(g.left_through_open_top(Vec<2>(10.01, 9.0), right)) << "through the right wall";
+  EXPECT_FALSE(g.left_through_open_top(Vec<2>(10.01, 9.99), Vec<2>(-1, -2))) << "moving in: it did not cross now";
+  EXPECT_FALSE(g.left_through_open_top(Vec<2>(5, -0.1), Vec<2>(0, -1))) << "through the floor";
+  EXPECT_FALSE(g.left_through_open_top(Vec<2>(5, 3), Vec<2>(0, -1))) << "into an obstacle";
+  g.open_top = false;
+  EXPECT_FALSE(g.left_through_open_top(Vec<2>(10.01, 10.5), right)) << "a closed top has no rim to pass";
 }
 
 TEST(Watchdog, ANonFinitePositionFromTheDriftIsAFailureNotAGridError) {

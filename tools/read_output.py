@@ -7,10 +7,11 @@ A run folder holds (docs/SCENES.md, "Output"):
   scene.json        the resolved scene (every default written out)
   series.csv        one row per output time: time, step, dt, counts, level_<l>, conserved quantities, probes
   frames/frame_NNNNNN.h5
-                    one group "frame_NNNNNN" per file, one dataset per particle field (ghosts left out),
-                    attributes time, step, frame, particles
+                    one group "frame_NNNNNN" per file, one dataset per particle field (ghosts left out) with
+                    its `units` attribute, attributes time, time_units, step, frame, particles
   frames.xdmf       ParaView's index of the frames (a temporal collection of point sets)
-  run.json          the summary, written when the run ends (absent if it was killed)
+  run.json          the summary, written when the run ends: "status" completed, or failed (the watchdog
+                    stopped it; "failure" says where and why); absent while it runs or if it was killed
   checkpoint.h5     with --checkpoint-every
 
 The functions load_series, load_frame, xdmf_datasets and summarize are importable. Exit status: 0 when the
@@ -47,15 +48,32 @@ def frame_files(folder):
     return sorted(os.path.join(d, n) for n in os.listdir(d) if n.startswith("frame_") and n.endswith(".h5"))
 
 
+def text(value):
+    """An HDF5 string attribute as str (h5py gives fixed-length strings as bytes)."""
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
 def load_frame(path):
-    """One frame: its attributes and every dataset as numpy arrays."""
+    """One frame: its attributes, every dataset as numpy arrays and their units (None where a dataset has none)."""
     with h5py.File(path, "r") as f:
         (group_name,) = list(f.keys())
         g = f[group_name]
-        frame = {k: (v.item() if hasattr(v, "item") else v) for k, v in g.attrs.items()}
+        frame = {k: (text(v) if isinstance(v, bytes) else v.item() if hasattr(v, "item") else v)
+                 for k, v in g.attrs.items()}
         frame["group"] = group_name
         frame["fields"] = {name: g[name][()] for name in g.keys()}
+        frame["units"] = {name: text(g[name].attrs["units"]) if "units" in g[name].attrs else None for name in g.keys()}
     return frame
+
+
+def run_status(folder):
+    """'completed' or 'failed' (run.json's status), or 'not finished' when there is no run.json yet (the run is
+    still going, or it was killed)."""
+    path = os.path.join(folder, "run.json")
+    if not os.path.exists(path):
+        return "not finished"
+    with open(path) as f:
+        return json.load(f).get("status", "completed")
 
 
 def xdmf_datasets(folder):
@@ -108,12 +126,17 @@ def summarize(folder, frame_index=-1):
         s["time_range"] = [float(series["time"][0]), float(series["time"][-1])]
         s["steps"] = int(series["step"][-1])
         mass = series["mass"]
-        s["mass_drift"] = float((mass[-1] - mass[0]) / mass[0]) if mass[0] else 0.0
+        # Fluid removed through an open top (container.outflow "remove") is accounted for, not lost.
+        removed_mass = series.get("removed_mass", np.zeros_like(mass))
+        s["removed"] = int(series["removed"][-1]) if "removed" in series else 0
+        s["removed_mass"] = float(removed_mass[-1])
+        s["mass_drift"] = float((mass[-1] + removed_mass[-1] - mass[0]) / mass[0]) if mass[0] else 0.0
         s["max_speed"] = float(np.max(series["max_speed"]))
         s["max_density_error"] = float(np.max(series["max_density_error"]))
         levels = sorted(k for k in series if k.startswith("level_"))
         s["final_per_level"] = {k: int(series[k][-1]) for k in levels}
-        known = {"time", "step", "dt", "fluid", "ghosts", "walls", "mass", "momentum_x", "momentum_y",
+        known = {"time", "step", "dt", "fluid", "ghosts", "walls", "mass", "removed", "removed_mass", "momentum_x",
+                 "momentum_y",
                  "angular_momentum", "kinetic", "potential", "elastic", "total_energy", "max_speed",
                  "max_density_error"} | set(levels)
         s["probes"] = {k: {"first": float(v[0]), "last": float(v[-1]), "min": float(np.nanmin(v)),
@@ -129,6 +152,7 @@ def summarize(folder, frame_index=-1):
             "step": int(fr["step"]),
             "particles": int(fr["particles"]),
             "fields": sorted(fr["fields"].keys()),
+            "units": fr["units"],
         }
         if kinds is not None:
             s["frame"]["kinds"] = {KIND_NAMES.get(int(k), str(k)): int(n) for k, n in zip(*np.unique(kinds, return_counts=True))}
@@ -140,20 +164,30 @@ def summarize(folder, frame_index=-1):
         s["problems"] = check_xdmf(folder)
     else:
         s["problems"] = [] if not files else ["frames.xdmf missing"]
+    s["status"] = run_status(folder)
     summary_path = os.path.join(folder, "run.json")
-    s["finished"] = os.path.exists(summary_path)
-    if s["finished"]:
+    if os.path.exists(summary_path):
         with open(summary_path) as f:
             s["summary"] = json.load(f)
+        if "failure" in s["summary"]:
+            s["failure"] = s["summary"]["failure"]
     return s
 
 
 def print_summary(s):
-    print(f"run {s['folder']}: scene {s['scene']}, {'finished' if s['finished'] else 'not finished'}")
+    print(f"run {s['folder']}: scene {s['scene']}, {s['status']}")
+    if "failure" in s:
+        f = s["failure"]
+        print(f"  failure     the watchdog stopped it at step {f['step']}, t = {f['time']:g} s ({f['kind']}): "
+              f"particle {f['particle']}: {f['quantity']}")
+        print(f"  cause       {f['cause']}")
+        print(f"  last good   step {f['last_good_step']}, t = {f['last_good_time']:g} s, in {f['checkpoint']}")
     if s["rows"]:
         t0, t1 = s["time_range"]
         print(f"  series      {s['rows']} rows, t = {t0:g} .. {t1:g} s of {s['end_time']:g} s, {s['steps']} steps")
-        print(f"  mass drift  {s['mass_drift']:+.3e}, max speed {s['max_speed']:.4g} m/s, "
+        if s["removed"]:
+            print(f"  removed     {s['removed']} fluid particles through the open top, {s['removed_mass']:.6g} kg/m")
+        print(f"  mass drift  {s['mass_drift']:+.3e} (removed fluid counted), max speed {s['max_speed']:.4g} m/s, "
               f"max density error {s['max_density_error']:.3e}")
         print("  per level   " + "  ".join(f"{k} {v}" for k, v in s["final_per_level"].items()))
         for name, p in s["probes"].items():
@@ -163,8 +197,9 @@ def print_summary(s):
         fr = s["frame"]
         print(f"  last frame  {fr['file']}: t = {fr['time']:g} s, step {fr['step']}, {fr['particles']} particles "
               f"{fr.get('kinds', {})}, fluid per level {fr.get('fluid_per_level', {})}")
-        print(f"  fields      {', '.join(fr['fields'])}")
-    if s["finished"]:
+        units = fr["units"]
+        print("  fields      " + ", ".join(f"{n} [{units.get(n)}]" for n in fr["fields"]))
+    if "summary" in s:
         r = s["summary"]
         print(f"  wall time   {r['wall_seconds']:.3f} s, {r['particle_steps_per_second']:.4g} particle-steps/s, "
               f"{r['threads']} threads")

@@ -123,7 +123,8 @@ def main():
             levels = [int(s[k][-1]) for k in sorted(c for c in s if c.startswith("level_"))]
         steps = summary.get("step", int(s["step"][-1]))
         wall = summary.get("wall_seconds", status.get("wall_seconds"))
-        mass_drift = (s["mass"][-1] - s["mass"][0]) / s["mass"][0]
+        removed_mass = s["removed_mass"][-1] if "removed_mass" in s else 0.0  # fluid removed through an open top
+        mass_drift = (s["mass"][-1] + removed_mass - s["mass"][0]) / s["mass"][0]
         out += ["| quantity | value |", "|---|---|",
                 "| outcome | %s |" % ("completed" if not failed else "stopped (exit %s): %s" % (code, stderr.replace("|", "/"))),
                 "| simulated time | %s s |" % fmt(float(s["time"][-1]), ".4g"),

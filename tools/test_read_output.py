@@ -3,9 +3,12 @@
 
     /usr/bin/python3 tools/test_read_output.py PATH/TO/sphrefine
 
-Checks that the reader finds every row, every frame and every field, that the XDMF's datasets exist with
-the announced shapes, that frame attributes agree with the time series, and that the command-line reader
-exits 0 on the run and 1 on a folder whose frame went missing. Exit status 0 on success, 1 on failure.
+Checks that the reader finds every row, every frame and every field (each with its units), that the XDMF's
+datasets exist with the announced shapes, that frame attributes agree with the time series, and that the
+command-line reader exits 0 on the run and 1 on a folder whose frame went missing. Then a block thrown over an
+open top's rim: with container.outflow "stop" the watchdog stops the run and the reader says it failed (not
+finished, not completed); with "remove" it completes and the reader's mass drift counts the removed mass.
+Exit status 0 on success, 1 on failure.
 """
 import json
 import os
@@ -36,6 +39,22 @@ SCENE = {
     "probes": [{"type": "water_height", "name": "H", "x": 0}, {"type": "surge_front", "name": "Z"}],
     "output": {"frame_interval": 0.01},
 }
+
+# A block thrown up and to the right from below the rim (y = 0.5 m) of an open box: above the rim before it
+# reaches the right side, it leaves over the top.
+THROWN = {
+    "name": "thrown",
+    "container": {"lo": [0, 0], "hi": [1, 0.5]},
+    "fluid": [{"shape": "rectangle", "lo": [0.6, 0.3], "hi": [0.8, 0.45], "spacing": 0.05, "velocity": [2, 5]}],
+    "material": {"rho0": 1000, "c0": 20},
+    "effects": {"gravity": [0, -9.81], "artificial_viscosity": {"alpha": 0.02}, "ghost_walls": "free-slip"},
+    "time": {"end": 0.3, "output_interval": 0.01},
+    "output": {"frame_interval": 0.1},
+}
+
+UNITS = {"acceleration": "m/s^2", "density": "kg/m^3", "density_half": "kg/m^3", "density_rate": "kg/m^3/s", "id": "1",
+         "kind": "1", "level": "1", "mass": "kg/m", "position": "m", "pressure": "Pa", "smoothing_length": "m",
+         "spacing": "m", "velocity": "m/s", "velocity_half": "m/s"}
 
 FIELDS = ["acceleration", "density", "density_half", "density_rate", "id", "kind", "level", "mass", "position",
           "pressure", "smoothing_length", "spacing", "velocity", "velocity_half"]
@@ -68,7 +87,7 @@ def main():
         s = read_output.summarize(out)
         series = read_output.load_series(out)
         check(s["scene"] == "tiny", "scene name")
-        check(s["finished"], "run.json written")
+        check(s.get("status") == "completed", f"status {s.get('status')}")
         check(s["problems"] == [], f"XDMF problems: {s['problems']}")
         check(s["rows"] >= 9, f"rows {s['rows']}")
         check(abs(series["time"][-1] - 0.04) < 1e-12, "last row at the end time")
@@ -83,6 +102,8 @@ def main():
             fr = read_output.load_frame(path)
             check(fr["frame"] == k and fr["group"] == f"frame_{k:06d}", f"frame {k} numbering")
             check(sorted(fr["fields"]) == FIELDS, f"frame {k} fields {sorted(fr['fields'])}")
+            check(fr.get("units") == UNITS, f"frame {k} units {fr.get('units')}")
+            check(fr.get("time_units") == "s", f"frame {k} time_units {fr.get('time_units')}")
             n = fr["particles"]
             check(fr["fields"]["position"].shape == (n, 2) and fr["fields"]["velocity"].shape == (n, 2), "vector shapes")
             for name in FIELDS:
@@ -112,6 +133,38 @@ def main():
         check(r.returncode == 1 and "PROBLEM" in r.stdout, f"broken folder: {r.returncode}")
         r = subprocess.run([sys.executable, os.path.join(HERE, "read_output.py"), tmp], capture_output=True, text=True)
         check(r.returncode == 2, f"non-run folder: {r.returncode}")
+        # Killed before run.json: not finished.
+        os.remove(os.path.join(broken, "run.json"))
+        check(read_output.summarize(broken).get("status") == "not finished", "a folder without run.json is not finished")
+
+        # A run the watchdog stopped: "failed", with the failure, never "finished" or "completed".
+        thrown = os.path.join(tmp, "thrown.json")
+        with open(thrown, "w") as f:
+            json.dump(THROWN, f)
+        stopped = os.path.join(tmp, "stopped")
+        r = subprocess.run([exe, "run", thrown, "-o", stopped, "-q"], capture_output=True, text=True, env=env)
+        check(r.returncode == 1, f"the thrown block with outflow stop exited {r.returncode}: {r.stderr}")
+        s = read_output.summarize(stopped)
+        check(s.get("status") == "failed", f"stopped run: status {s.get('status')}")
+        check(s.get("failure", {}).get("kind") == "left_open_top", f"stopped run: failure {s.get('failure')}")
+        r = subprocess.run([sys.executable, os.path.join(HERE, "read_output.py"), stopped], capture_output=True, text=True)
+        first = r.stdout.splitlines()[0] if r.stdout else ""
+        check(first.endswith("failed"), f"read_output.py's first line: {first!r}")
+        check("finished" not in r.stdout and "completed" not in r.stdout, f"read_output.py says: {r.stdout}")
+        check("through the open top" in r.stdout, f"read_output.py names the failure: {r.stdout}")
+
+        # The same with outflow "remove": completes, the block is removed, the mass drift counts it.
+        removed = os.path.join(tmp, "removed")
+        r = subprocess.run([exe, "run", thrown, "-o", removed, "-q", "--set", "container.outflow=remove"],
+                           capture_output=True, text=True, env=env)
+        check(r.returncode == 0, f"the thrown block with outflow remove exited {r.returncode}: {r.stderr}")
+        s = read_output.summarize(removed)
+        series = read_output.load_series(removed)
+        check(s.get("status") == "completed", f"removed run: status {s.get('status')}")
+        check(s.get("removed") == 12 and series["fluid"][-1] == 0, f"removed {s.get('removed')}, fluid {series['fluid'][-1]}")
+        # M is 0 at the end and the removed mass a compensated sum of the same 12 masses: equal up to rounding.
+        check(abs(s["mass_drift"]) <= 2 * np.finfo(float).eps, f"mass drift with removed fluid {s['mass_drift']}")
+        check(s["summary"]["removed_particles"] == 12, f"run.json removed {s['summary'].get('removed_particles')}")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     print("test_read_output:", "FAILED" if failures else "passed", f"({len(failures)} failures)")

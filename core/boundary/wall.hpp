@@ -4,6 +4,7 @@
 // helpers that build them, so a sloped segment can come later.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -40,12 +41,17 @@ struct Box2 {
   }
 };
 
-/// The solid geometry of a scene: a container (fluid inside, open at the top if `open_top`) and
-/// rectangular obstacles (fluid outside).
+/// What happens to fluid that leaves through an open top (over the rim): the watchdog stops the run, or the
+/// step removes it (core/boundary/outflow.hpp), counting it and its mass.
+enum class Outflow : std::uint8_t { stop, remove };
+
+/// The solid geometry of a scene: a container (fluid inside, open at the top if `open_top`, with what happens to
+/// fluid leaving through it) and rectangular obstacles (fluid outside).
 struct Geometry2 {
   Box2 container{Vec<2>(0, 0), Vec<2>(1, 1)};
   bool open_top = true;
   std::vector<Box2> obstacles;
+  Outflow outflow = Outflow::stop;
 
   /// Every wall segment with its normal into the fluid.
   std::vector<Wall2> walls() const {
@@ -73,6 +79,30 @@ struct Geometry2 {
       if (b.contains_strictly(x)) return false;
     }
     return true;
+  }
+
+  /// For a particle outside the fluid domain at x that drifted along u in its last step (x = x_prev + dt u,
+  /// with x_prev inside): true when it left through the open top, i.e. beside the container above the rim
+  /// or having crossed a side wall's line above the rim (over the wall's top, then down within the step);
+  /// false when it went through a wall (the floor, a side wall below the rim, or into an obstacle).
+  /// Traced back along u to the side line, so it depends neither on dt nor on how far the step went.
+  bool left_through_open_top(const Vec<2>& x, const Vec<2>& u) const {
+    if (!open_top) return false;
+    const double rim = container.hi[1];
+    double side;  // the side line the particle is beyond
+    if (x[0] < container.lo[0]) {
+      side = container.lo[0];
+    } else if (x[0] > container.hi[0]) {
+      side = container.hi[0];
+    } else {
+      return false;  // within the span and out of the domain: below the floor or inside an obstacle
+    }
+    if (x[1] > rim) return true;
+    // Below the rim now: where did its path cross the side line? Only a path that moved outwards crossed it.
+    const double outward = x[0] < container.lo[0] ? -u[0] : u[0];
+    if (!(outward > 0.0)) return false;
+    const double y_cross = x[1] - u[1] * ((x[0] - side) / u[0]);
+    return y_cross > rim;
   }
 
   /// Distance from x to the nearest wall segment (for daughters near walls).

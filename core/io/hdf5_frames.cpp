@@ -124,14 +124,17 @@ std::string read_string_attribute(hid_t object, const char* name) {
 
 bool has_attribute(hid_t object, const char* name) { return H5Aexists(object, name) > 0; }
 
+/// One field as a dataset named after it, with its unit as the dataset's `units` attribute.
 template <class T>
-void write_dataset(hid_t group, const std::string& name, const std::vector<T>& values) {
+void write_dataset(hid_t group, const Field<T>& field, const std::vector<T>& values) {
   using Tr = H5Traits<T>;
+  const std::string name(field.name());
   const hsize_t dims[2] = {values.size(), static_cast<hsize_t>(Tr::components)};
   const Handle space(H5Screate_simple(Tr::components > 1 ? 2 : 1, dims, nullptr), H5Sclose, "create a dataspace");
   const Handle set(H5Dcreate2(group, name.c_str(), Tr::type(), space, kDefault, kDefault, kDefault), H5Dclose,
                    "create dataset " + name);
   if (!values.empty()) check(H5Dwrite(set, Tr::type(), H5S_ALL, H5S_ALL, kDefault, values.data()), "write dataset " + name);
+  write_string_attribute(set, "units", std::string(field.unit()));
 }
 
 template <class T>
@@ -193,13 +196,14 @@ FrameHeader write_frame(const std::filesystem::path& file, const std::string& gr
     const Handle f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, kDefault, kDefault), H5Fclose, "create " + tmp.string());
     const Handle g(H5Gcreate2(f, group.c_str(), kDefault, kDefault, kDefault), H5Gclose, "create group " + group);
     write_attribute(g, "time", H5T_NATIVE_DOUBLE, time);
+    write_string_attribute(g, "time_units", "s");  // step, frame and particles are counts
     write_attribute(g, "step", H5T_NATIVE_UINT64, step);
     write_attribute(g, "frame", H5T_NATIVE_UINT64, index);
     write_attribute(g, "particles", H5T_NATIVE_UINT64, header.particles);
     store.for_each_field([&](const auto& field) {
       if (!wanted(fields, field.name())) return;
       using T = typename std::decay_t<decltype(field)>::value_type;
-      write_dataset(g, std::string(field.name()), gathered(field, keep));
+      write_dataset(g, field, gathered(field, keep));
       header.fields.push_back(H5Traits<T>::layout(std::string(field.name())));
     });
   }
@@ -247,6 +251,7 @@ void write_checkpoint(const std::filesystem::path& file, const ParticleStore<2>&
     write_attribute(g, "time", H5T_NATIVE_DOUBLE, state.time);
     write_attribute(g, "step", H5T_NATIVE_UINT64, state.step);
     write_attribute(g, "dt", H5T_NATIVE_DOUBLE, state.dt);
+    write_string_attribute(g, "time_units", "s");  // of time and dt
     write_attribute(g, "next_id", H5T_NATIVE_UINT64, state.next_id);
     write_attribute(g, "next_row", H5T_NATIVE_UINT64, state.next_row);
     write_attribute(g, "next_frame", H5T_NATIVE_UINT64, state.next_frame);
@@ -256,9 +261,12 @@ void write_checkpoint(const std::filesystem::path& file, const ParticleStore<2>&
     write_attribute(g, "initial_mass", H5T_NATIVE_DOUBLE, state.initial_mass);
     write_attribute(g, "initial_momentum_x", H5T_NATIVE_DOUBLE, state.initial_momentum_x);
     write_attribute(g, "initial_momentum_y", H5T_NATIVE_DOUBLE, state.initial_momentum_y);
+    write_attribute(g, "removed_particles", H5T_NATIVE_UINT64, state.removed_particles);
+    write_attribute(g, "removed_mass", H5T_NATIVE_DOUBLE, state.removed_mass);
+    write_attribute(g, "removed_mass_compensation", H5T_NATIVE_DOUBLE, state.removed_mass_compensation);
     write_attribute(g, "particles", H5T_NATIVE_UINT64, static_cast<std::uint64_t>(keep.size()));
     write_string_attribute(g, "scene", state.scene);
-    store.for_each_field([&](const auto& field) { write_dataset(g, std::string(field.name()), gathered(field, keep)); });
+    store.for_each_field([&](const auto& field) { write_dataset(g, field, gathered(field, keep)); });
   }
   commit_file(file);
 }
@@ -297,6 +305,12 @@ CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore
   s.initial_mass = read_attribute<double>(g, "initial_mass", H5T_NATIVE_DOUBLE);
   s.initial_momentum_x = read_attribute<double>(g, "initial_momentum_x", H5T_NATIVE_DOUBLE);
   s.initial_momentum_y = read_attribute<double>(g, "initial_momentum_y", H5T_NATIVE_DOUBLE);
+  // Absent from checkpoints written before outflow removal existed: nothing was removed then.
+  if (has_attribute(g, "removed_particles")) {
+    s.removed_particles = read_attribute<std::uint64_t>(g, "removed_particles", H5T_NATIVE_UINT64);
+    s.removed_mass = read_attribute<double>(g, "removed_mass", H5T_NATIVE_DOUBLE);
+    s.removed_mass_compensation = read_attribute<double>(g, "removed_mass_compensation", H5T_NATIVE_DOUBLE);
+  }
   s.scene = read_string_attribute(g, "scene");
   const auto n = read_attribute<std::uint64_t>(g, "particles", H5T_NATIVE_UINT64);
   store.clear();

@@ -3,8 +3,9 @@
 //
 // A frame file holds one group (named like "frame_000012") with one dataset per particle field (named
 // after the field: "position" N x 2, "density" N, "level" N, ...) for every particle except ghosts, in
-// store order, and the attributes time (s), step, frame and particles. A checkpoint file holds group
-// "checkpoint" with every field and the whole state needed to continue bitwise identically. Every file
+// store order, each with a `units` attribute (the field's unit, ParticleStore), and the attributes time,
+// time_units ("s"), step, frame and particles. A checkpoint file holds group "checkpoint" with every field
+// (with units too) and the whole state needed to continue bitwise identically. Every file
 // is written under a temporary name and renamed when complete (core/io/atomic_file.hpp).
 #include <cstdint>
 #include <filesystem>
@@ -61,6 +62,9 @@ struct CheckpointState {
   double initial_mass = 0.0;      // the run's state at t = 0, for the drift in the summary
   double initial_momentum_x = 0.0;
   double initial_momentum_y = 0.0;
+  std::uint64_t removed_particles = 0;     // fluid removed through the open top so far (Simulation::removed)
+  double removed_mass = 0.0;               // its mass: the compensated sum's value and compensation, so a
+  double removed_mass_compensation = 0.0;  // resumed run adds later removals exactly as the uninterrupted one
   std::string scene;             // the scene (JSON) the run was started from
 };
 

@@ -36,10 +36,13 @@ bool due(double t, std::uint64_t index, double interval) {
 
 double frame_interval(const Scene& s) { return s.output.frame_interval.value_or(s.time.interval()); }
 
-/// The scene with what a resumed run may change (end time, outputs, probes, names) left out.
+/// The scene with what a resumed run may change (end time, outputs, probes, names, outflow) left out. The outflow
+/// may change because a run stopped by fluid leaving over the rim (outflow "stop") has removed nothing up to its
+/// checkpoint, exactly as a run with "remove" would have: resumed with "remove", it continues as that run.
 Json physics_of(const Scene& s) {
   Json j = scene_to_json(s);
   for (const char* key : {"name", "description", "time", "probes", "output"}) j.erase(key);
+  j["container"].erase("outflow");
   return j;
 }
 
@@ -60,7 +63,7 @@ Runner::Runner(Scene scene, RunOptions options)
       throw SceneError("--resume", "the checkpoint does not hold a readable scene");
     }
     if (physics_of(original) != physics_of(scene_)) {
-      throw SceneError("--resume", "the checkpoint was written by a different scene (only time, probes and output may change)");
+      throw SceneError("--resume", "the checkpoint was written by a different scene (only time, probes, output and container.outflow may change)");
     }
     // The first step after the checkpoint is the one it recorded; with a changed time.cfl (the way on after
     // a watchdog stop) or dt_max it follows the new settings at once (dt = cfl * limit, capped by dt_max).
@@ -76,6 +79,11 @@ Runner::Runner(Scene scene, RunOptions options)
     particle_steps_ = state.particle_steps;
     initial_mass_ = state.initial_mass;
     initial_momentum_ = Vec<2>(state.initial_momentum_x, state.initial_momentum_y);
+    RemovedFluid removed;
+    removed.particles = state.removed_particles;
+    removed.mass.sum = state.removed_mass;
+    removed.mass.c = state.removed_mass_compensation;
+    sim_.set_removed(removed);
     last_row_step_ = last_frame_step_ = last_checkpoint_step_ = state.step;
     resumed_ = true;
   } else {
@@ -100,7 +108,7 @@ bool Runner::finished() const { return !(sim_.time() < scene_.time.end * (1.0 - 
 std::vector<std::string> Runner::columns() const {
   std::vector<std::string> c{"time", "step", "dt", "fluid", "ghosts", "walls"};
   for (int l = 0; l <= finest_level(scene_); ++l) c.push_back("level_" + std::to_string(l));
-  for (const char* name : {"mass", "momentum_x", "momentum_y", "angular_momentum", "kinetic", "potential", "elastic",
+  for (const char* name : {"mass", "removed", "removed_mass", "momentum_x", "momentum_y", "angular_momentum", "kinetic", "potential", "elastic",
                            "total_energy", "max_speed", "max_density_error"}) {
     c.emplace_back(name);
   }
@@ -209,7 +217,7 @@ void Runner::write_row() {
     const auto k = static_cast<std::size_t>(l);
     row.push_back(k < d.per_level.size() ? static_cast<double>(d.per_level[k]) : 0.0);
   }
-  for (const double v : {d.mass, d.momentum[0], d.momentum[1], d.angular_momentum, d.kinetic, d.potential, d.elastic,
+  for (const double v : {d.mass, static_cast<double>(d.removed), d.removed_mass, d.momentum[0], d.momentum[1], d.angular_momentum, d.kinetic, d.potential, d.elastic,
                          d.total_energy(), d.max_speed, d.max_density_error}) {
     row.push_back(v);
   }
@@ -244,6 +252,9 @@ void Runner::write_checkpoint() {
   s.initial_mass = initial_mass_;
   s.initial_momentum_x = initial_momentum_[0];
   s.initial_momentum_y = initial_momentum_[1];
+  s.removed_particles = sim_.removed().particles;
+  s.removed_mass = sim_.removed().mass.sum;
+  s.removed_mass_compensation = sim_.removed().mass.c;
   s.scene = scene_to_json(scene_).dump();
   io::write_checkpoint(files_.checkpoint(), sim_.store(), s);
   last_checkpoint_step_ = s.step;
@@ -258,7 +269,8 @@ RunSummary Runner::summary() const {
   r.final = sim_.diagnostics();
   r.initial_mass = initial_mass_;
   r.initial_momentum = initial_momentum_;
-  r.mass_drift = initial_mass_ > 0.0 ? (r.final.mass - initial_mass_) / initial_mass_ : 0.0;
+  // Removed fluid left through the open top: it is accounted for, not lost (M + removed = M0).
+  r.mass_drift = initial_mass_ > 0.0 ? (r.final.mass + r.final.removed_mass - initial_mass_) / initial_mass_ : 0.0;
   r.momentum_change = (r.final.momentum - initial_momentum_).norm();
   r.rows = rows_;
   r.frames = frames_written_;
@@ -286,13 +298,14 @@ void Runner::write_summary(const RunSummary& r, const FailureReport* failure) {
   j["particle_steps"] = r.particle_steps;
   j["particle_steps_per_second"] = r.wall_seconds > 0.0 ? static_cast<double>(r.particle_steps) / r.wall_seconds : 0.0;
   j["fluid_per_level"] = r.final.per_level;
+  j["removed_particles"] = r.final.removed;
+  j["removed_mass"] = r.final.removed_mass;
   j["mass_drift"] = r.mass_drift;
   j["momentum_change"] = r.momentum_change;
   j["rows"] = r.rows;
   j["frames"] = r.frames;
   if (failure) {
-    static constexpr const char* kinds[] = {"not_finite", "density", "left_domain"};
-    j["failure"] = {{"kind", kinds[static_cast<int>(failure->kind)]},
+    j["failure"] = {{"kind", to_string(failure->kind)},
                     {"step", failure->step},
                     {"time", failure->time},
                     {"particle", failure->id},
@@ -320,7 +333,9 @@ void Runner::fail(const FailureReport& report) {
                   static_cast<unsigned long long>(step), sim_.time());
     where = buf;
     if (scene_.output.frames) where += (options_.folder / frames_.back().file).string() + " and ";
-    where += files_.checkpoint().string() + " (continue with --resume and a smaller time.cfl).";
+    where += files_.checkpoint().string() + (report.kind == FailureKind::left_open_top
+                                                 ? " (continue with --resume and --set container.outflow=remove)."
+                                                 : " (continue with --resume and a smaller time.cfl).");
   }
   throw RunFailure(report.message() + "." + where, report);
 }

@@ -71,7 +71,7 @@ struct RunSummary {
   Diagnostics final;
   double initial_mass = 0.0;
   Vec<2> initial_momentum = Vec<2>::Zero();
-  double mass_drift = 0.0;      // (M - M0) / M0
+  double mass_drift = 0.0;      // (M + removed mass - M0) / M0: fluid removed through the open top is accounted
   double momentum_change = 0.0; // |P - P0| (kg m/s); walls and gravity change it physically
   std::uint64_t rows = 0, frames = 0, checkpoints = 0;
 };

@@ -175,6 +175,7 @@ const char* to_string(Criterion v) {
   }
   return "?";
 }
+const char* to_string(Outflow v) { return v == Outflow::stop ? "stop" : "remove"; }
 const char* to_string(Pattern v) { return v == Pattern::aap ? "aap" : "rsp"; }
 const char* to_string(ProbeKind v) {
   switch (v) {

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/boundary/wall.hpp"
 #include "core/types.hpp"
 
 namespace sph::scene {
@@ -21,6 +22,7 @@ struct Rect {
 struct Container {
   Rect box;
   bool open_top = true;
+  Outflow outflow = Outflow::stop;  // fluid leaving over the open top's rim: stop the run, or remove it
   bool operator==(const Container&) const = default;
 };
 
@@ -219,5 +221,6 @@ const char* to_string(Slip v);
 const char* to_string(Criterion v);
 const char* to_string(Pattern v);
 const char* to_string(ProbeKind v);
+const char* to_string(Outflow v);
 
 }  // namespace sph::scene

@@ -53,6 +53,7 @@ SolverSettings solver_settings(const Scene& scene) {
   s.ghost_pressure = e.ghost_pressure_mirrored ? GhostPressure::mirrored : GhostPressure::hydrostatic;
   s.geometry.container = box(scene.container.box);
   s.geometry.open_top = scene.container.open_top;
+  s.geometry.outflow = scene.container.outflow;
   for (const Rect& o : scene.obstacles) s.geometry.obstacles.push_back(box(o));
   s.cfl = scene.time.cfl;
   s.dt_max = scene.time.dt_max;

@@ -157,8 +157,9 @@ Rect parse_rect(const Json& j, const std::string& path) {
 }
 
 Container parse_container(const Json& j, const std::string& path) {
-  ObjectReader r(j, path, {"lo", "hi", "open_top"});
-  return Container{Rect{r.vec2("lo"), r.vec2("hi")}, r.boolean("open_top", true)};
+  ObjectReader r(j, path, {"lo", "hi", "open_top", "outflow"});
+  return Container{Rect{r.vec2("lo"), r.vec2("hi")}, r.boolean("open_top", true),
+                   r.choice<Outflow>("outflow", {{"stop", Outflow::stop}, {"remove", Outflow::remove}}, Outflow::stop)};
 }
 
 FluidRegion parse_region(const Json& j, const std::string& path) {

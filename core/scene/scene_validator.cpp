@@ -142,6 +142,10 @@ void validate_scene(const Scene& s) {
     }
   }
   valid_rect(s.container.box, "container");
+  if (s.container.outflow == Outflow::remove && !s.container.open_top) {
+    fail("container.outflow", "\"remove\" needs an open top (open_top: true): a closed container has no opening to "
+                              "leave through");
+  }
   for (std::size_t k = 0; k < s.obstacles.size(); ++k) {
     const std::string path = element("obstacles", k);
     valid_rect(s.obstacles[k], path);

@@ -15,7 +15,8 @@ Json scene_to_json(const Scene& s) {
   Json j;
   j["name"] = s.name;
   if (!s.description.empty()) j["description"] = s.description;
-  j["container"] = Json{{"lo", vec(s.container.box.lo)}, {"hi", vec(s.container.box.hi)}, {"open_top", s.container.open_top}};
+  j["container"] = Json{{"lo", vec(s.container.box.lo)}, {"hi", vec(s.container.box.hi)}, {"open_top", s.container.open_top},
+                        {"outflow", to_string(s.container.outflow)}};
   if (!s.obstacles.empty()) {
     j["obstacles"] = Json::array();
     for (const auto& o : s.obstacles) j["obstacles"].push_back(rect(o));
