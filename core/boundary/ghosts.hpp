@@ -2,9 +2,10 @@
 // Ghost particles (section 2.4): every fluid particle within 2 h_i of a wall is mirrored across it, and a
 // particle near two perpendicular walls (a corner) also gets the doubly reflected ghost. Ghosts copy
 // mass, density, pressure and smoothing length; their velocity is reflected (free-slip: normal part
-// reversed) or reversed (no-slip). They are rebuilt from scratch each step by one stream expansion
-// through the store's registry (old ghosts dropped, new ones written right after their source), so the
-// result is deterministic at any thread count.
+// reversed) or reversed (no-slip). The solver rebuilds them from scratch each step
+// (Simulation::prepare_neighbours): one stream expansion through the store's registry, output_count() outputs
+// per particle (old ghosts dropped), composed with the cell sort into one gather, then make_ghost() on each
+// copy that is an image; the result is deterministic at any thread count.
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -12,7 +13,6 @@
 #include "core/boundary/wall.hpp"
 #include "core/equation_of_state.hpp"
 #include "core/particle_store.hpp"
-#include "parallel/compaction.hpp"
 
 namespace sph {
 
@@ -68,7 +68,7 @@ class GhostBuilder {
     return out;
   }
 
-  /// How many outputs particle i has in a rebuild: old ghosts 0, walls 1, fluid 1 + its images.
+  /// How many outputs particle i has in the ghost expansion: old ghosts 0, walls 1, fluid 1 + its images.
   std::uint32_t output_count(const ParticleView<2>& view, std::size_t i) const {
     if (view.kind[i] == Kind::ghost) return 0;
     if (view.kind[i] != Kind::fluid) return 1;
@@ -87,29 +87,6 @@ class GhostBuilder {
     s.kind[k] = Kind::ghost;
     s.a[k].setZero();
     s.drho[k] = 0.0;
-  }
-
-  /// Drops the old ghosts and writes the new ones right after their source particle.
-  void rebuild(ParticleStore<2>& store) const {
-    std::vector<std::uint32_t> offsets;
-    const auto view = store.view();
-    const std::vector<std::uint32_t> src = par::expansion_map(
-        store.size(),
-        [&](std::size_t i) -> std::uint32_t {
-          if (view.kind[i] == Kind::ghost) return 0;
-          if (view.kind[i] != Kind::fluid) return 1;
-          return 1u + static_cast<std::uint32_t>(images(view.x[i], view.v[i], view.h[i]).count);
-        },
-        &offsets);
-    // Every output starts as a copy of its source; the copies after the first become its ghosts, through
-    // make_ghost as in the solver's pipeline (so the ghost-pressure mode applies here too).
-    store.gather(src);
-    auto s = store.view();
-    par::parallel_for(offsets.size() - 1, [&](std::size_t i) {
-      const std::uint32_t first = offsets[i];
-      const std::uint32_t count = offsets[i + 1] - first;
-      for (std::uint32_t g = 1; g < count; ++g) make_ghost(s, first + g, static_cast<int>(g - 1));
-    });
   }
 
   /// Removes every ghost (before output, refinement or checkpoints).
