@@ -6,8 +6,10 @@
 #include <CLI/CLI.hpp>
 
 #include "app/commands.hpp"
+#include "core/allocator_tuning.hpp"
 
 int main(int argc, char** argv) {
+  sph::tune_allocator();
   CLI::App app{"sphrefine: weakly-compressible SPH with dynamic particle refinement"};
   app.require_subcommand(1);
 
