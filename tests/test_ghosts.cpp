@@ -1,16 +1,20 @@
 // Ghost particles (section 2.4) as the solver builds them (Simulation::prepare_neighbours, the step's one
 // expansion composed with the cell sort): each fluid particle gets exactly its images (GhostBuilder::images)
 // carrying its id, every other field copied; old ghosts are dropped, wall particles left alone, for both slip
-// conditions and both ghost-pressure modes.
+// conditions and both ghost-pressure modes. Which images a particle gets: one per wall in reach, one per
+// perpendicular pair of those walls that meets at a corner, at most four walls (the nearest).
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <map>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "core/boundary/ghosts.hpp"
+#include "core/setup.hpp"
 #include "core/simulation.hpp"
 #include "tests/support/physics_helpers.hpp"
 
@@ -210,6 +214,92 @@ TEST(Ghosts, ReachIsTwiceTheSmoothingLengthAndTheTopIsOpenUnlessClosed) {
   ASSERT_EQ(ob.count, 1);
   EXPECT_NEAR((ob.x[0] - Vec<2>(5.0, 2.6)).norm(), 0.0, 1e-12);
   EXPECT_EQ(ob.v[0], Vec<2>(0.5, 1.0));
+}
+
+/// Expects images `im` to be exactly `x` (positions) and `v` (velocities), in that order.
+void expect_images(const GhostBuilder::Images& im, const std::vector<Vec<2>>& x, const std::vector<Vec<2>>& v) {
+  ASSERT_EQ(im.count, static_cast<int>(x.size()));
+  for (std::size_t g = 0; g < x.size(); ++g) {
+    EXPECT_NEAR((im.x[g] - x[g]).norm(), 0.0, 1e-12) << "image " << g << ": " << im.x[g].transpose();
+    EXPECT_EQ(im.v[g], v[g]) << "image " << g;
+  }
+}
+
+// Walls beside an obstacle: a particle in a gap narrower than 4 h between an obstacle standing on the floor and
+// the right wall has three walls in reach (the shipped scenes, which have no obstacles, never have more than
+// two): an image for each, and a corner image for each perpendicular pair that meets, here the container's
+// bottom-right corner and the obstacle's foot.
+TEST(Ghosts, EveryWallInReachAndEveryCornerWhereTwoMeetGiveAnImage) {
+  SolverSettings st = box_settings(GhostSlip::free_slip, GhostPressure::mirrored);
+  st.geometry.obstacles.push_back({Vec<2>(7, 0), Vec<2>(8.5, 6)});  // gap x in [8.5, 10]
+  const GhostBuilder gb(st.geometry.walls(), GhostSlip::free_slip);
+  const Vec<2> v(0.7, -0.4);
+  // Walls in list order: bottom, right wall, the obstacle's right face; then the corners bottom x right wall
+  // and bottom x the obstacle's face (the face ends on the floor); the two vertical walls are parallel.
+  expect_images(gb.images(Vec<2>(9.25, 0.4), v, 0.6),
+                {Vec<2>(9.25, -0.4), Vec<2>(10.75, 0.4), Vec<2>(7.75, 0.4), Vec<2>(10.75, -0.4), Vec<2>(7.75, -0.4)},
+                {Vec<2>(0.7, 0.4), Vec<2>(-0.7, -0.4), Vec<2>(-0.7, -0.4), Vec<2>(-0.7, 0.4), Vec<2>(-0.7, 0.4)});
+  // At the obstacle's other foot: the floor, its left face, and the corner where they meet.
+  expect_images(gb.images(Vec<2>(6.7, 0.3), v, 0.6), {Vec<2>(6.7, -0.3), Vec<2>(7.3, 0.3), Vec<2>(7.3, -0.3)},
+                {Vec<2>(0.7, 0.4), Vec<2>(-0.7, -0.4), Vec<2>(-0.7, 0.4)});
+  // Higher up in the gap: the two parallel walls only.
+  expect_images(gb.images(Vec<2>(9.25, 3.0), v, 0.6), {Vec<2>(10.75, 3.0), Vec<2>(7.75, 3.0)},
+                {Vec<2>(-0.7, -0.4), Vec<2>(-0.7, -0.4)});
+}
+
+TEST(Ghosts, PerpendicularWallsThatDoNotMeetGiveNoCornerImage) {
+  SolverSettings st = box_settings(GhostSlip::free_slip, GhostPressure::mirrored);
+  st.geometry.obstacles.push_back({Vec<2>(4, 1), Vec<2>(6, 3)});  // clear of the floor by 1 m
+  const GhostBuilder gb(st.geometry.walls(), GhostSlip::free_slip);
+  // Near the floor and the obstacle's left face, which ends 1 m above the floor: no corner between them.
+  expect_images(gb.images(Vec<2>(3.7, 1.1), Vec<2>(0.7, -0.4), 0.6), {Vec<2>(3.7, -1.1), Vec<2>(4.3, 1.1)},
+                {Vec<2>(0.7, 0.4), Vec<2>(-0.7, -0.4)});
+}
+
+TEST(Ghosts, BeyondFourWallsInReachTheNearestFourAreMirrored) {
+  // A pocket among thin obstacles: five walls within 2 h = 1.2 of (4, 0.8): the floor at 0.8, a thin plate's
+  // top at 0.3, two obstacles' facing sides at 0.5 each and an obstacle's bottom face at 0.7 above. The floor,
+  // farthest, gets no image; none of the perpendicular pairs meet.
+  SolverSettings st = box_settings(GhostSlip::free_slip, GhostPressure::mirrored);
+  st.geometry.obstacles = {{Vec<2>(2, 0.3), Vec<2>(6, 0.5)},
+                           {Vec<2>(4.5, 0.6), Vec<2>(5, 3)},
+                           {Vec<2>(3, 0.6), Vec<2>(3.5, 3)},
+                           {Vec<2>(3.6, 1.5), Vec<2>(4.4, 2)}};
+  const GhostBuilder gb(st.geometry.walls(), GhostSlip::free_slip);
+  const Vec<2> x(4.0, 0.8), v(0.7, -0.4);
+  ASSERT_TRUE(st.geometry.in_fluid_domain(x));
+  // In wall-list order: the plate's top, the second obstacle's left face, the third's right face, the
+  // fourth's bottom face.
+  expect_images(gb.images(x, v, 0.6), {Vec<2>(4.0, 0.2), Vec<2>(5.0, 0.8), Vec<2>(3.0, 0.8), Vec<2>(4.0, 2.2)},
+                {Vec<2>(0.7, 0.4), Vec<2>(-0.7, -0.4), Vec<2>(-0.7, -0.4), Vec<2>(0.7, 0.4)});
+}
+
+// What the rule is for: still water in a 1.5 m gap between an obstacle and the right wall (three particle
+// columns at d = 0.5 m, 2 h = 1.2 m) stays still. With images of the first two walls found only (the bottom
+// and the right wall), the bottom particle at the obstacle's foot got no image of its face and ran into the
+// obstacle at t = 0.86 s.
+TEST(Ghosts, StillWaterInAGapBesideAnObstacleStaysStill) {
+  const double depth = 5.0, d = 0.5, g = 9.81;
+  SolverSettings st = box_settings(GhostSlip::free_slip, GhostPressure::hydrostatic);
+  st.eos.c0 = 10.0 * std::sqrt(2.0 * g * depth);
+  st.geometry.obstacles.push_back({Vec<2>(6, 0), Vec<2>(8.5, 7)});
+  sph::Simulation sim(st);
+  sph::FluidBlockSpec block;
+  block.spacing = d;
+  for (const auto& [lo, hi] : {std::pair{Vec<2>(0, 0), Vec<2>(6, depth)}, std::pair{Vec<2>(8.5, 0), Vec<2>(10, depth)}}) {
+    sph::add_fluid(sim.store(), sph::lattice_rectangle(lo, hi, d), block, st.eos.rho0);
+  }
+  sph::set_hydrostatic(sim.store(), 0, sim.store().size(), depth, g, st.eos);
+  sim.refresh();
+  const double t_end = 1.0;
+  ASSERT_NO_THROW(sim.run_until(t_end));  // the watchdog stops a particle entering the obstacle
+  // Still water stays still: no speed beyond a small fraction of the long-wave speed sqrt(g depth).
+  EXPECT_LT(sim.diagnostics().max_speed, 0.05 * std::sqrt(g * depth));
+  for (std::size_t i = 0; i < sim.store().size(); ++i) {
+    if (sim.store().kind[i] == Kind::fluid) {
+      EXPECT_TRUE(st.geometry.in_fluid_domain(sim.store().x[i]));
+    }
+  }
 }
 
 TEST(Ghosts, HydrostaticGhostPressureAddsTheWeightOfTheGapBelowTheWall) {
