@@ -281,7 +281,7 @@ TEST(Ghosts, BeyondFourWallsInReachTheNearestFourAreMirrored) {
 TEST(Ghosts, StillWaterInAGapBesideAnObstacleStaysStill) {
   const double depth = 5.0, d = 0.5, g = 9.81;
   SolverSettings st = box_settings(GhostSlip::free_slip, GhostPressure::hydrostatic);
-  st.eos.c0 = 10.0 * std::sqrt(2.0 * g * depth);
+  st.eos.c0 = sph::sound_speed_from_height(10.0, g, depth);
   st.geometry.obstacles.push_back({Vec<2>(6, 0), Vec<2>(8.5, 7)});
   sph::Simulation sim(st);
   sph::FluidBlockSpec block;
