@@ -7,9 +7,11 @@
 
 #include "app/commands.hpp"
 #include "app/wait_policy.hpp"
+#include "core/allocator_tuning.hpp"
 
 int main(int argc, char** argv) {
   sph::app::ensure_wait_policy(argv);  // may start the program again, before anything else happens
+  sph::tune_allocator();
   CLI::App app{"sphrefine: weakly-compressible SPH with dynamic particle refinement"};
   app.require_subcommand(1);
 

@@ -19,6 +19,7 @@
 #include <random>
 #include <vector>
 
+#include "core/allocator_tuning.hpp"
 #include "core/cell_grid.hpp"
 #include "core/particle_store.hpp"
 #include "parallel/parallel_for.hpp"
@@ -28,6 +29,8 @@ namespace {
 using sph::CellGrid;
 using sph::ParticleStore;
 using Store = ParticleStore<2>;
+
+const bool tuned = (sph::tune_allocator(), true);
 
 constexpr double kSpacing = 1.0;
 constexpr double kH = 1.2 * kSpacing;

@@ -9,11 +9,14 @@
 
 #include <cmath>
 
+#include "core/allocator_tuning.hpp"
 #include "core/case_builder.hpp"
 
 namespace {
 
 using namespace sph;
+
+const bool tuned = (tune_allocator(), true);
 
 struct PeerCase {
   double dp;

@@ -41,7 +41,7 @@ void apply_refinement(Simulation& sim, bool fully_refined, const std::optional<r
 Simulation make_still_tank(const TankSpec& spec) {
   SolverSettings s;
   s.eos.rho0 = 1000.0;
-  s.eos.c0 = spec.mach_factor * std::sqrt(kG * spec.depth);
+  s.eos.c0 = sound_speed_from_height(spec.mach_factor, kG, spec.reference_height);
   s.geometry.container = {Vec<2>(0, 0), Vec<2>(spec.width, 2.0 * spec.depth)};
   s.ghost_pressure = spec.ghost_pressure;
   if (spec.density_diffusion) s.density_diffusion = DensityDiffusionSettings{0.1};
@@ -58,7 +58,7 @@ Simulation make_still_tank(const TankSpec& spec) {
 Simulation make_dam_break(const DamBreakSpec& spec) {
   SolverSettings s;
   s.eos.rho0 = 1000.0;
-  s.eos.c0 = spec.mach_factor * std::sqrt(2.0 * kG * spec.column_height);
+  s.eos.c0 = sound_speed_from_height(spec.mach_factor, kG, spec.column_height);
   s.geometry.container = {Vec<2>(0, 0), Vec<2>(spec.tank_width, spec.tank_height)};
   if (!spec.viscosity) s.viscosity.reset();
   if (!spec.ghosts) s.ghosts.reset();
@@ -79,7 +79,7 @@ Simulation make_dam_break(const DamBreakSpec& spec) {
 Simulation make_drop(const DropSpec& spec) {
   SolverSettings s;
   s.eos.rho0 = 1000.0;
-  s.eos.c0 = spec.mach_factor * std::sqrt(kG * spec.depth);
+  s.eos.c0 = sound_speed_from_height(spec.mach_factor, kG, spec.reference_height);
   s.viscosity = ViscositySettings{spec.alpha, 0.0};
   if (spec.density_diffusion) s.density_diffusion = DensityDiffusionSettings{0.1};
   const double half = 0.5 * spec.width;

@@ -4,6 +4,14 @@
 
 namespace sph {
 
+/// The sound speed from a Mach factor and a reference height H (PHYSICS.md, eq. (8) decision; docs/SCENES.md,
+/// material.reference_height): c0 = mach_factor * sqrt(2 g H), sqrt(2 g H) being the free-fall speed from H.
+/// Flow at that speed then compresses the fluid by about 1 / mach_factor^2 (1 % at the default 10), and so does
+/// a hydrostatic column 2 H deep at its floor (g 2H / c0^2).
+inline double sound_speed_from_height(double mach_factor, double g, double height) {
+  return mach_factor * std::sqrt(2.0 * g * height);
+}
+
 struct TaitEquationOfState {
   double rho0 = 1000.0;
   double c0 = 10.0;

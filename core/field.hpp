@@ -48,9 +48,6 @@ class Field {
   T* gather_scratch() { return scratch_.data(); }
   void gather_commit() { std::swap(data_, scratch_); }
 
-  /// Frees the scratch buffer (after a one-off gather, to give memory back).
-  void release_scratch() { std::vector<T>().swap(scratch_); }
-
   std::size_t bytes() const { return (data_.capacity() + scratch_.capacity()) * sizeof(T); }
 
  private:

@@ -39,10 +39,4 @@ std::vector<std::uint32_t> compaction_map(std::size_t n, Keep&& keep) {
   return expansion_map(n, [&](std::size_t i) { return keep(i) ? 1u : 0u; });
 }
 
-/// Permutation / gather: out[k] = in[src[k]] for k in [0, src.size()).
-template <class T>
-void gather(const T* in, const std::uint32_t* src, std::size_t m, T* out) {
-  parallel_for(m, [&](std::size_t k) { out[k] = in[src[k]]; });
-}
-
 }  // namespace sph::par

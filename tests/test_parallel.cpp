@@ -229,26 +229,6 @@ TEST(Parallel, CompactionMapEqualsSerialFilter) {
   }
 }
 
-TEST(Parallel, GatherEqualsSerialGather) {
-  for (const std::size_t n : sizes()) {
-    std::vector<double> in(n);
-    for (std::size_t i = 0; i < n; ++i) in[i] = mixed_double(i);
-    // A source map with repeats and omissions, longer than the input (an expansion-like gather).
-    const std::size_t m = n == 0 ? 0 : n + n / 3;
-    std::vector<std::uint32_t> src(m);
-    for (std::size_t k = 0; k < m; ++k) src[k] = static_cast<std::uint32_t>(mix(k + 11) % n);
-    std::vector<double> expected(m);
-    for (std::size_t k = 0; k < m; ++k) expected[k] = in[src[k]];
-    for (const int t : kThreadCounts) {
-      SCOPED_TRACE(label(n, t));
-      const ThreadCount tc(t);
-      std::vector<double> out(m, -1.0);
-      par::gather(in.data(), src.data(), m, out.data());
-      EXPECT_EQ(out, expected);
-    }
-  }
-}
-
 TEST(Parallel, IntegerSumAndReduceEqualSerialReference) {
   for (const std::size_t n : sizes()) {
     std::uint64_t expected_sum = 0;

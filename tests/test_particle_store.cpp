@@ -194,25 +194,31 @@ TYPED_TEST(ParticleStoreTest, CompactionKeepsSurvivorsInOrderWithTheirFields) {
   EXPECT_EQ(inconsistent_entries(s), 0u);
 }
 
-TYPED_TEST(ParticleStoreTest, ExpansionCopiesEveryFieldToEachCopy) {
+TYPED_TEST(ParticleStoreTest, ExpansionCopiesEveryFieldToEachCopyAtAnyThreadCount) {
   constexpr int D = TestFixture::kDim;
-  const std::size_t n = 5003;
-  ParticleStore<D> s = filled_store<D>(n);
-  // Particle i becomes id % 4 copies (0 removes it): a gather with repeated indices.
-  std::vector<std::uint32_t> offsets;
-  const auto src = par::expansion_map(
-      n, [&](std::size_t i) { return static_cast<std::uint32_t>(s.id[i] % 4); }, &offsets);
-  s.gather(src);
-  ASSERT_EQ(s.size(), src.size());
-  for (std::size_t i = 0; i < n; ++i) {
-    for (std::uint32_t k = offsets[i]; k < offsets[i + 1]; ++k) ASSERT_EQ(s.id[k], i);
+  const std::size_t n = 5003;  // the static worksharing loops split unevenly across threads
+  for (const int threads : {1, 2, 3}) {
+    SCOPED_TRACE(threads);
+    ParticleStore<D> s = filled_store<D>(n);
+    // Particle i becomes id % 4 copies (0 removes it): a gather with repeated indices.
+    std::vector<std::uint32_t> offsets;
+    const auto src = par::expansion_map(
+        n, [&](std::size_t i) { return static_cast<std::uint32_t>(s.id[i] % 4); }, &offsets);
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(threads);
+    s.gather(src);
+    omp_set_num_threads(saved);
+    ASSERT_EQ(s.size(), src.size());
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::uint32_t k = offsets[i]; k < offsets[i + 1]; ++k) ASSERT_EQ(s.id[k], i);
+    }
+    // Copies carry the same values, so consistency by id covers them all.
+    EXPECT_EQ(inconsistent_entries(s), 0u);
+    // The refinement step then gives the copies fresh ids; they do not collide with any id ever handed out.
+    const ParticleId first = s.take_ids(s.size());
+    EXPECT_EQ(first, n);
+    EXPECT_EQ(s.next_id(), n + s.size());
   }
-  // Copies carry the same values, so consistency by id covers them all.
-  EXPECT_EQ(inconsistent_entries(s), 0u);
-  // The refinement step then gives the copies fresh ids; they do not collide with any id ever handed out.
-  const ParticleId first = s.take_ids(s.size());
-  EXPECT_EQ(first, n);
-  EXPECT_EQ(s.next_id(), n + s.size());
 }
 
 TYPED_TEST(ParticleStoreTest, AppendAfterRemovalNeverReusesIds) {

@@ -6,6 +6,7 @@
 #include <random>
 
 #include "core/case_builder.hpp"
+#include "core/refinement/criteria.hpp"
 #include "core/refinement/patterns.hpp"
 #include "core/refinement/refinement_stage.hpp"
 #include "core/refinement/split_pass.hpp"
@@ -223,13 +224,32 @@ bool same_state(const ParticleStore<2>& a, const ParticleStore<2>& b) {
 TEST(Refinement, ResultIsBitwiseIndependentOfThreadCountAndOfTheCriterion) {
   const int threads = omp_get_max_threads();
   ParticleStore<2> base = random_cloud(30000, 11);
-  // The velocity criterion and a zone criterion that mark exactly the same particles.
+  // The velocity criterion and the zone criterion, each through make_criterion as the refinement stage builds
+  // them, marking exactly the same particles: the velocities are set so that a particle is faster than the
+  // threshold exactly when it lies inside the zone (speeds 1..2.5 m/s outside, 3.5..5 m/s inside).
+  const Box2 zone{Vec<2>(2.5, 3.0), Vec<2>(6.0, 7.5)};
+  for (std::size_t i = 0; i < base.size(); ++i) {
+    const double speed = base.v[i].norm();  // 0 .. 5 sqrt(2)
+    const double fraction = speed / (5.0 * std::sqrt(2.0));
+    const double target = zone.contains(base.x[i]) ? 3.5 + 1.5 * fraction : 1.0 + 1.5 * fraction;
+    base.v[i] = speed > 0.0 ? Vec<2>(base.v[i] * (target / speed)) : Vec<2>(target, 0.0);
+  }
   refine::RefinementSettings by_speed;
+  by_speed.criterion = refine::CriterionKind::velocity;
   by_speed.v_threshold = 3.0;
-  std::vector<std::uint8_t> m_speed(base.size(), 0);
-  refine::make_criterion(by_speed)->mark(base, m_speed);
-  std::vector<std::uint8_t> m_zone(base.size(), 0);
-  for (std::size_t i = 0; i < base.size(); ++i) m_zone[i] = base.v[i].norm() > 3.0 ? 1 : 0;
+  refine::RefinementSettings by_zone;
+  by_zone.criterion = refine::CriterionKind::zone;
+  by_zone.zone = zone;
+  std::vector<std::uint8_t> m_speed(base.size(), 0), m_zone(base.size(), 0);
+  const auto speed_criterion = refine::make_criterion(by_speed);
+  const auto zone_criterion = refine::make_criterion(by_zone);
+  ASSERT_STREQ(speed_criterion->name(), "velocity");
+  ASSERT_STREQ(zone_criterion->name(), "zone");
+  speed_criterion->mark(base, m_speed);
+  zone_criterion->mark(base, m_zone);
+  const auto marked = static_cast<std::size_t>(std::count(m_zone.begin(), m_zone.end(), 1));
+  ASSERT_GT(marked, base.size() / 10);  // the zone holds about a fifth of the cloud
+  ASSERT_LT(marked, base.size() / 2);
   ASSERT_EQ(m_speed, m_zone);
   for (Pattern p : {Pattern::aap, Pattern::rsp}) {
     ParticleStore<2> one = base, two = base, other = base;

@@ -1,15 +1,22 @@
 // The pair sweep: pair forces are antisymmetric with mixed smoothing lengths (section 2.3), and the
 // sweep equals an independent O(N^2) evaluation of eqs. (5), (6), (9) and (10), with and without the
-// optional artificial stress (Monaghan 2000) and density diffusion (delta-SPH).
+// optional artificial stress (Monaghan 2000) and density diffusion (delta-SPH), on grids the tests build and
+// on the solver's own (a refined dam break with wall particles and ghosts, as Simulation::refresh leaves it).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <filesystem>
 #include <limits>
 #include <vector>
 
 #include "core/kernel.hpp"
+#include "core/scene/scene_builder.hpp"
+#include "core/scene/scene_parser.hpp"
 #include "core/sweep_factory.hpp"
+#include "tests/support/brute_force.hpp"
 #include "tests/support/physics_helpers.hpp"
 
 namespace {
@@ -187,10 +194,14 @@ Reference brute_force(const ParticleStore<2>& s, const SolverSettings& st) {
   return ref;
 }
 
-void expect_matches_brute_force(ParticleStore<2>& s, const SolverSettings& st, const char* what) {
-  CellGrid<2> grid;
-  build_grid(s, grid);
-  const sph::SweepLimits lim = sph::make_sweep(st)->run(s.view(), grid);
+/// Compares the rates and limits a sweep left in `s` with the brute-force evaluation of the same state.
+/// Tolerance: both add the same terms (the brute force in index order, with its own but equal expressions for
+/// grad W and (r0/r)^12), so each term differs by a few ulps and each sum by rounding, of order
+/// n_neighbours * 1e-16 of the sum of the terms' magnitudes (~1e-14 at ~50 neighbours). 1e-12 of that sum
+/// leaves a factor ~100; a missing or extra pair changes a sum by a whole term, or, at the edge of the support
+/// where grad W vanishes, changes the pair count, which must match exactly.
+void expect_rates_match_brute_force(const ParticleStore<2>& s, const sph::SweepLimits& lim, const SolverSettings& st,
+                                    const char* what) {
   const Reference ref = brute_force(s, st);
   std::size_t checked = 0;
   for (std::size_t i = 0; i < s.size(); ++i) {
@@ -207,6 +218,14 @@ void expect_matches_brute_force(ParticleStore<2>& s, const SolverSettings& st, c
   EXPECT_EQ(lim.pairs, ref.pairs) << what;
   EXPECT_NEAR(lim.dt_force, ref.dt_force, 1e-12 * ref.dt_force) << what;
   EXPECT_NEAR(lim.dt_cfl, ref.dt_cfl, 1e-12 * ref.dt_cfl) << what;
+}
+
+/// The sweep on a grid built here (cell size 2 h_max), against the brute force.
+void expect_matches_brute_force(ParticleStore<2>& s, const SolverSettings& st, const char* what) {
+  CellGrid<2> grid;
+  build_grid(s, grid);
+  const sph::SweepLimits lim = sph::make_sweep(st)->run(s.view(), grid);
+  expect_rates_match_brute_force(s, lim, st, what);
 }
 
 /// How many particles a term moves beyond the comparison's tolerance: the acceleration or density rate of
@@ -319,6 +338,57 @@ TEST(Sweep, EqualsBruteForceWithDensityDiffusion) {
     SolverSettings off = st;
     off.density_diffusion.reset();
     EXPECT_GT(changed_density_rates(brute_force(s, st), brute_force(s, off)), 100u);
+  }
+}
+
+// The twin on the solver's own path: the store, ghosts, grid and rates exactly as Simulation::refresh() leaves
+// them (the cell size and query reach that prepare_neighbours computes, the driver's ghost expansion), in a
+// dam break with Lennard-Jones wall particles, free-slip ghost walls and a statically refined quarter (level-1
+// particles next to level-0 ones and next to walls), set in motion. The twins above choose their own grid.
+TEST(Sweep, SolverPathEqualsBruteForceInARefinedDamBreakWithWallsAndGhosts) {
+  const std::filesystem::path cases = std::filesystem::path(__FILE__).parent_path().parent_path() / "cases";
+  for (bool more_effects : {false, true}) {
+    SCOPED_TRACE(more_effects ? "with density diffusion and artificial stress" : "dam_break.json's effects");
+    sph::scene::Json doc = sph::scene::read_json_file(cases / "dam_break.json");
+    doc["effects"]["static_refinement"] = sph::scene::Json{{"box", {{"lo", {0, 0}}, {"hi", {12.5, 12.5}}}}};
+    if (more_effects) {
+      doc["effects"]["density_diffusion"] = sph::scene::Json{{"delta", 0.1}};
+      doc["effects"]["artificial_stress"] = sph::scene::Json{{"epsilon", 0.2}};
+    }
+    sph::Simulation sim = sph::scene::build_simulation(sph::scene::scene_from_json(doc));
+    // At rest every velocity is zero and continuity and viscosity vanish: 200 steps (t ~ 0.1 s) set the
+    // column moving (the front at about 1 m/s).
+    for (int k = 0; k < 200; ++k) sim.step();
+    sim.refresh();
+    const ParticleStore<2>& s = sim.store();
+    const SolverSettings& st = sim.settings();
+    ASSERT_TRUE(st.lennard_jones && st.ghosts && st.viscosity);
+    std::size_t kinds[3] = {0, 0, 0}, levels[2] = {0, 0};
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      ++kinds[static_cast<int>(s.kind[i])];
+      if (s.kind[i] == Kind::fluid) ++levels[s.level[i] == 0 ? 0 : 1];
+    }
+    ASSERT_GT(kinds[static_cast<int>(Kind::wall)], 100u);
+    ASSERT_GT(kinds[static_cast<int>(Kind::ghost)], 100u);
+    ASSERT_GT(levels[0], 100u);
+    ASSERT_GT(levels[1], 100u);
+    // The neighbour sets of the solver's grid are the brute force's, and they include mixed-level pairs.
+    const auto expected = brute_force_neighbours(s.x.values(), s.h.values());
+    std::size_t mixed = 0;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      if (s.kind[i] != Kind::fluid) continue;
+      std::vector<std::uint32_t> got;
+      sim.grid().for_each_neighbour(i, s.x.data(), s.h.data(), [&](std::uint32_t j, double) { got.push_back(j); });
+      std::sort(got.begin(), got.end());
+      EXPECT_EQ(got, expected[i]) << "neighbours of " << i << " at " << s.x[i].transpose();
+      for (std::uint32_t j : got) mixed += s.kind[j] == Kind::fluid && s.level[j] != s.level[i];
+    }
+    EXPECT_GT(mixed, 100u);
+    expect_rates_match_brute_force(s, sim.last_limits(), st, "solver path");
+    // The comparison is sharp: the flow is under way, so viscosity alone moves many accelerations.
+    SolverSettings inviscid = st;
+    inviscid.viscosity.reset();
+    EXPECT_GT(changed_accelerations(brute_force(s, st), brute_force(s, inviscid)), 100u);
   }
 }
 

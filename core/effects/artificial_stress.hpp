@@ -12,7 +12,6 @@
 namespace sph {
 
 struct ArtificialStress {
-  static constexpr bool needs_gradient = true;
   double epsilon = 0.2;
   int exponent = 4;
 

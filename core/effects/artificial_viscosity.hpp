@@ -7,7 +7,6 @@
 namespace sph {
 
 struct ArtificialViscosity {
-  static constexpr bool needs_gradient = true;
   double alpha = 0.02;
   double beta = 0.0;
   double c0 = 10.0;

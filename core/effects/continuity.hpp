@@ -5,7 +5,6 @@
 namespace sph {
 
 struct Continuity {
-  static constexpr bool needs_gradient = true;
   template <int D>
   void operator()(const ParticleView<D>& s, const Pair<D>& pr, PairSums<D>& acc) const {
     acc.drho += s.m[pr.j] * pr.vij.dot(pr.gradW);

@@ -14,7 +14,6 @@ namespace sph {
 
 template <int D>
 struct DensityDiffusion {
-  static constexpr bool needs_gradient = true;
   double delta = 0.1;
   double c0 = 10.0;
   Vec<D> hydrostatic = Vec<D>::Zero();  // (rho0 / c0^2) g: the hydrostatic density gradient

@@ -6,7 +6,6 @@
 namespace sph {
 
 struct LennardJonesWall {
-  static constexpr bool needs_gradient = false;
   double strength = 1.0;   // D, m^2/s^2
   double r0_factor = 0.5;  // r0 = r0_factor * d_i
 

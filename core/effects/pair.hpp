@@ -28,11 +28,4 @@ struct PairSums {
   Vec<D> a = Vec<D>::Zero();
 };
 
-/// A list of effects applied in order to every pair; an effect absent from the list costs nothing.
-template <class... Effects>
-struct EffectPack {
-  static constexpr bool empty = sizeof...(Effects) == 0;
-  static constexpr bool needs_gradient = (Effects::needs_gradient || ... || false);
-};
-
 }  // namespace sph

@@ -5,7 +5,6 @@
 namespace sph {
 
 struct PressureGradient {
-  static constexpr bool needs_gradient = true;
   template <int D>
   void operator()(const ParticleView<D>& s, const Pair<D>& pr, PairSums<D>& acc) const {
     const double rj = s.rho[pr.j];

@@ -54,10 +54,11 @@ inline Offsets rotated_scaled_pattern(double d_i, const Reference& ref, double k
   return square_pattern(k * d_i / ref.F, ref.direction);
 }
 
-/// The wall rule (documented in docs/REFINEMENT.md): every daughter must stay at least `margin` inside every
-/// wall the parent is near. The pattern is first compressed along the wall normal (symmetrically, so the
-/// centroid stays at x_i and conservation is exact); only if the parent itself sits closer than the margin
-/// is the (compressed) pattern shifted inward, which moves the centroid. Returns true when it shifted.
+/// The wall rule (docs/METHOD.md, "Daughters near walls"): every daughter must stay at least `margin` inside
+/// every wall the parent is near. The pattern is first compressed along the wall normal (symmetrically, so the
+/// centroid stays at x_i and conservation is exact), to no less than a quarter of its extent; only if the
+/// deepest daughter is still closer than the margin is the compressed pattern shifted inward, which moves the
+/// centroid. Returns true when it shifted.
 inline bool keep_inside_walls(const Vec<2>& xi, Offsets& o, const std::vector<Wall2>& walls, double margin) {
   bool shifted = false;
   double reach = 0.0;

@@ -6,7 +6,9 @@
 #include <limits>
 #include <numbers>
 
+
 #include "core/cell_grid.hpp"
+#include "core/equation_of_state.hpp"
 #include "core/particle_store.hpp"
 #include "core/scene/scene_builder.hpp"
 #include "core/scene/scene_parser.hpp"
@@ -28,7 +30,7 @@ double sound_speed(const Scene& s) {
   if (m.c0) return *m.c0;
   const double factor = m.mach_factor.value_or(10.0);
   if (m.reference_speed) return factor * *m.reference_speed;
-  if (m.reference_height) return factor * std::sqrt(2.0 * gravity_magnitude(s) * *m.reference_height);
+  if (m.reference_height) return sound_speed_from_height(factor, gravity_magnitude(s), *m.reference_height);
   return 0.0;
 }
 
