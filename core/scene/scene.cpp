@@ -6,7 +6,6 @@
 #include <limits>
 #include <numbers>
 
-
 #include "core/cell_grid.hpp"
 #include "core/equation_of_state.hpp"
 #include "core/particle_store.hpp"
