@@ -289,6 +289,26 @@ def main():
                      "steps"], rows)
         md += [""]
 
+    if runs.get("busy"):
+        # BM_Program/<case>/<variant>/<quiet|busy>: whole `sphrefine run` processes, 1 s of the dam break.
+        times = {}
+        for b in runs["busy"]:
+            parts = b["name"].split("/")
+            if len(parts) >= 4:
+                times[(parts[1], parts[2], parts[3])] = ms(b) / 1e3
+        rows = []
+        for (case, variant) in sorted({(c, v) for (c, v, _) in times}):
+            quiet, busy = times.get((case, variant, "quiet")), times.get((case, variant, "busy"))
+            if quiet and busy:
+                rows.append([case, variant.replace("_", " "), "%.2f" % quiet, "%.2f" % busy, "%.1fx" % (busy / quiet)])
+        md += ["### The program on busy cores (`sph_bench_busy`)", "",
+               "`sphrefine run cases/dam_break.json` to t = 1 s as a whole process, on quiet cores and with a busy loop "
+               "on every core (threads of the benchmark, started before the run and stopped after it). `default` is "
+               "the program as a user starts it (threads from the work, passive wait policy); `old 2threads active` "
+               "forces what it did before (`--threads 2`, `OMP_WAIT_POLICY=active`). Target: busy at most 2x quiet.", ""]
+        md += table(["case", "variant", "quiet (s)", "busy (s)", "busy / quiet"], rows)
+        md += [""]
+
     md += [END]
     block = "\n".join(md)
     text = open(DOC).read() if os.path.exists(DOC) else "# Performance\n"
