@@ -34,14 +34,13 @@ void counting_sort(std::size_t n, std::size_t buckets, Key&& key, CountingSortRe
   out.bucket_start.resize(buckets + 1);
   out.bucket_start[buckets] = static_cast<std::uint32_t>(n);
   out.order.resize(n);
-  // The exclusive scan of the table, blocked like par::exclusive_scan (fixed kChunk blocks).
+  // The exclusive scan of the table (par::team_exclusive_scan, inside this function's region).
   const std::size_t table = scratch.size();
   const std::size_t blocks = chunk_count(table);
   thread_local std::vector<std::uint32_t> block_total_buffer;  // reused; see par::reduce for the reference
   std::vector<std::uint32_t>& block_total = block_total_buffer;
   block_total.assign(blocks + 1, 0);
   const auto n_chunks = static_cast<std::ptrdiff_t>(chunks);
-  const auto n_blocks = static_cast<std::ptrdiff_t>(blocks);
   const auto n_buckets = static_cast<std::ptrdiff_t>(buckets);
   std::uint32_t* t = scratch.data();
   // One parallel region for the whole sort (each region costs a fork and a join); the worksharing loops'
@@ -59,25 +58,7 @@ void counting_sort(std::size_t n, std::size_t buckets, Key&& key, CountingSortRe
         ++t[k * chunks + cc];
       }
     }
-#pragma omp for schedule(static)
-    for (std::ptrdiff_t b = 0; b < n_blocks; ++b) {
-      std::uint32_t acc = 0;
-      const std::size_t end = std::min(table, (static_cast<std::size_t>(b) + 1) * kChunk);
-      for (std::size_t i = static_cast<std::size_t>(b) * kChunk; i < end; ++i) acc += t[i];
-      block_total[static_cast<std::size_t>(b) + 1] = acc;
-    }
-#pragma omp single
-    for (std::size_t b = 0; b < blocks; ++b) block_total[b + 1] += block_total[b];
-#pragma omp for schedule(static)
-    for (std::ptrdiff_t b = 0; b < n_blocks; ++b) {
-      std::uint32_t acc = block_total[static_cast<std::size_t>(b)];
-      const std::size_t end = std::min(table, (static_cast<std::size_t>(b) + 1) * kChunk);
-      for (std::size_t i = static_cast<std::size_t>(b) * kChunk; i < end; ++i) {
-        const std::uint32_t v = t[i];
-        t[i] = acc;
-        acc += v;
-      }
-    }
+    team_exclusive_scan(t, t, table, block_total.data());
 #pragma omp for schedule(static)
     for (std::ptrdiff_t b = 0; b < n_buckets; ++b) {
       out.bucket_start[static_cast<std::size_t>(b)] = chunks ? t[static_cast<std::size_t>(b) * chunks] : 0;

@@ -9,6 +9,34 @@
 namespace sph::par {
 
 /// out[i] = sum_{k<i} in[k]; returns the grand total. `out` may alias `in`. Works for n = 0.
+/// The scan's three phases for a team already inside a parallel region (orphaned worksharing: every thread of
+/// the team calls it): chunk totals, their serial scan by one thread, then each chunk's offsets. `total` is
+/// shared, with chunk_count(n) + 1 entries, total[0] = 0; total[chunks] is the grand total afterwards.
+template <class T>
+void team_exclusive_scan(const T* in, T* out, std::size_t n, T* total) {
+  const std::size_t chunks = chunk_count(n);
+  const auto count = static_cast<std::ptrdiff_t>(chunks);
+#pragma omp for schedule(static)
+  for (std::ptrdiff_t c = 0; c < count; ++c) {
+    T acc{};
+    const std::size_t end = std::min(n, (static_cast<std::size_t>(c) + 1) * kChunk);
+    for (std::size_t i = static_cast<std::size_t>(c) * kChunk; i < end; ++i) acc += in[i];
+    total[static_cast<std::size_t>(c) + 1] = acc;
+  }
+#pragma omp single
+  for (std::size_t c = 0; c < chunks; ++c) total[c + 1] += total[c];
+#pragma omp for schedule(static)
+  for (std::ptrdiff_t c = 0; c < count; ++c) {
+    T acc = total[static_cast<std::size_t>(c)];
+    const std::size_t end = std::min(n, (static_cast<std::size_t>(c) + 1) * kChunk);
+    for (std::size_t i = static_cast<std::size_t>(c) * kChunk; i < end; ++i) {
+      const T v = in[i];
+      out[i] = acc;
+      acc += v;
+    }
+  }
+}
+
 template <class T>
 T exclusive_scan(const T* in, T* out, std::size_t n) {
   const std::size_t chunks = chunk_count(n);
@@ -17,31 +45,10 @@ T exclusive_scan(const T* in, T* out, std::size_t n) {
   thread_local std::vector<T> buffer;
   std::vector<T>& total = buffer;
   total.assign(chunks + 1, T{});
-  const auto count = static_cast<std::ptrdiff_t>(chunks);
-  // One parallel region (each costs a fork and a join): chunk totals, the serial scan of the totals by one
-  // thread, then each chunk's offsets.
+  T* t = total.data();
+  // One parallel region (each costs a fork and a join).
 #pragma omp parallel
-  {
-#pragma omp for schedule(static)
-    for (std::ptrdiff_t c = 0; c < count; ++c) {
-      T acc{};
-      const std::size_t end = std::min(n, (static_cast<std::size_t>(c) + 1) * kChunk);
-      for (std::size_t i = static_cast<std::size_t>(c) * kChunk; i < end; ++i) acc += in[i];
-      total[static_cast<std::size_t>(c) + 1] = acc;
-    }
-#pragma omp single
-    for (std::size_t c = 0; c < chunks; ++c) total[c + 1] += total[c];
-#pragma omp for schedule(static)
-    for (std::ptrdiff_t c = 0; c < count; ++c) {
-      T acc = total[static_cast<std::size_t>(c)];
-      const std::size_t end = std::min(n, (static_cast<std::size_t>(c) + 1) * kChunk);
-      for (std::size_t i = static_cast<std::size_t>(c) * kChunk; i < end; ++i) {
-        const T v = in[i];
-        out[i] = acc;
-        acc += v;
-      }
-    }
-  }
+  team_exclusive_scan(in, out, n, t);
   return total[chunks];
 }
 
