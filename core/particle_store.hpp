@@ -31,6 +31,8 @@ struct ParticleView {
   Vec<D>* a = nullptr;
   Vec<D>* vh = nullptr;
   double* rhoh = nullptr;
+  double* level_time = nullptr;
+  Origin* origin = nullptr;
 };
 
 template <int D>
@@ -56,6 +58,10 @@ class ParticleStore {
   // Integrator stage state (kick-drift-kick): velocity and density at the half step.
   Field<VecD> vh{"velocity_half", "m/s"};
   Field<double> rhoh{"density_half", "kg/m^3"};
+  // When the particle took its level (its split, or the merge that made it); 0 for the set-up's particles.
+  // Coarsening holds a family at its level for a minimum time (core/refinement/merge_pass.hpp).
+  Field<double> level_time{"level_time", "s"};
+  Field<Origin> origin{"origin", "1"};  // core/types.hpp: a fresh merge is not split at the next check
 
   /// The registry: every field as a pointer to member. Adding a field above and here is all it takes for
   /// every operation (gather, compaction, expansion, copies, output, checkpoints) to carry it.
@@ -63,7 +69,8 @@ class ParticleStore {
     return std::make_tuple(&ParticleStore::x, &ParticleStore::v, &ParticleStore::rho, &ParticleStore::p,
                            &ParticleStore::m, &ParticleStore::h, &ParticleStore::d, &ParticleStore::level,
                            &ParticleStore::kind, &ParticleStore::id, &ParticleStore::drho, &ParticleStore::a,
-                           &ParticleStore::vh, &ParticleStore::rhoh);
+                           &ParticleStore::vh, &ParticleStore::rhoh, &ParticleStore::level_time,
+                           &ParticleStore::origin);
   }
 
   /// Visits every field. f is called with each Field<T>&.
@@ -163,7 +170,8 @@ class ParticleStore {
 
   ParticleView<D> view() {
     return {size(), x.data(), v.data(), rho.data(), p.data(), m.data(), h.data(), d.data(),
-            level.data(), kind.data(), id.data(), drho.data(), a.data(), vh.data(), rhoh.data()};
+            level.data(), kind.data(), id.data(), drho.data(), a.data(), vh.data(), rhoh.data(), level_time.data(),
+            origin.data()};
   }
 
   /// Bytes held by every field (data and scratch), for memory reports.
@@ -175,7 +183,8 @@ class ParticleStore {
 
   /// Bytes one particle occupies across all fields.
   static constexpr std::size_t bytes_per_particle() {
-    return 4 * sizeof(VecD) + 7 * sizeof(double) + sizeof(std::int32_t) + sizeof(Kind) + sizeof(ParticleId);
+    return 4 * sizeof(VecD) + 8 * sizeof(double) + sizeof(std::int32_t) + sizeof(Kind) + sizeof(ParticleId) +
+           sizeof(Origin);
   }
 
  private:

@@ -13,6 +13,10 @@ using Vec = Eigen::Matrix<double, D, 1>;
 /// or a ghost mirrored from a fluid particle across a wall (section 2.4).
 enum class Kind : std::uint8_t { fluid = 0, wall = 1, ghost = 2 };
 
+/// How a particle took its level: at set-up, as a daughter of a split, or as the particle a merge made
+/// (`fresh_merge` until the refinement check after that merge, which does not split it, then `merge`).
+enum class Origin : std::uint8_t { setup = 0, split = 1, fresh_merge = 2, merge = 3 };
+
 using Index = std::uint32_t;
 using ParticleId = std::uint64_t;
 

@@ -69,13 +69,17 @@ struct H5Traits<std::int32_t> {
   static constexpr int components = 1;
   static FieldLayout layout(std::string n) { return {std::move(n), "Int", 4, 1}; }
 };
-template <>
-struct H5Traits<Kind> {
-  static_assert(sizeof(Kind) == 1);
+template <class E>
+struct ByteEnumTraits {
+  static_assert(sizeof(E) == 1);
   static hid_t type() { return H5T_NATIVE_UINT8; }
   static constexpr int components = 1;
   static FieldLayout layout(std::string n) { return {std::move(n), "UChar", 1, 1}; }
 };
+template <>
+struct H5Traits<Kind> : ByteEnumTraits<Kind> {};
+template <>
+struct H5Traits<Origin> : ByteEnumTraits<Origin> {};
 template <>
 struct H5Traits<std::uint64_t> {
   static hid_t type() { return H5T_NATIVE_UINT64; }

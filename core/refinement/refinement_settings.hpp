@@ -17,6 +17,16 @@ enum class CriterionKind {
   few_neighbours  // fewer than min_neighbours fluid neighbours within 2 h_ij
 };
 
+/// Coarsening: the four daughters of a parent merge back into one when all four have been at their level for
+/// hold_time and all four pass the merge test of the criterion, which is stricter than the split test
+/// (hysteresis): velocity |v| < v_threshold (below the split threshold); zone: outside the zone;
+/// few_neighbours: at least min_neighbours fluid neighbours (above the split count).
+struct CoarseningSettings {
+  double v_threshold = 5.0;  // m/s
+  int min_neighbours = 16;
+  double hold_time = 0.5;    // s
+};
+
 struct RefinementSettings {
   CriterionKind criterion = CriterionKind::velocity;
   double v_threshold = 10.0;  // m/s
@@ -26,6 +36,7 @@ struct RefinementSettings {
   double rsp_k = 1.0;       // 1/2 as printed in the paper, 1 the consistent reading
   int check_interval = 100; // steps between checks
   int max_level = 1;        // daughters of level max_level are never refined
+  std::optional<CoarseningSettings> coarsening;  // none: nothing ever merges
 };
 
 }  // namespace sph::refine

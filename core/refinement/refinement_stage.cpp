@@ -19,7 +19,8 @@ std::vector<std::size_t> level_counts(const ParticleStore<2>& store) {
 
 std::size_t split_with(Simulation& sim, std::vector<std::uint8_t>& marks, Pattern pattern, double rsp_k,
                        int max_level) {
-  const SplitResult r = split_marked(sim.store(), marks, pattern, rsp_k, max_level, sim.settings().geometry.walls());
+  const SplitResult r =
+      split_marked(sim.store(), marks, pattern, rsp_k, max_level, sim.settings().geometry.walls(), sim.time());
   sim.refresh();
   return r.refined;
 }
@@ -35,16 +36,50 @@ bool RefinementStage::after_step(Simulation& sim) {
   ParticleStore<2>& store = sim.store();
   std::vector<std::uint8_t> marks(store.size(), 0);
   criterion_->mark(store, marks);
+  if (settings_.coarsening) {
+    // A particle a merge made at the last check is not split at this one (no family flips from one check to
+    // the next: the merge test looked one check ahead, but an impact can still change course within it).
+    for (std::size_t i = 0; i < store.size(); ++i) {
+      if (store.origin[i] == Origin::fresh_merge) {
+        marks[i] = 0;
+        store.origin[i] = Origin::merge;
+      }
+    }
+  }
   bool any = false;
   for (std::size_t i = 0; i < store.size() && !any; ++i) {
     any = marks[i] && store.kind[i] == Kind::fluid && store.level[i] < settings_.max_level;
   }
-  if (!any) return false;
-  const SplitResult r =
-      split_marked(store, marks, settings_.pattern, settings_.rsp_k, settings_.max_level, sim.settings().geometry.walls());
-  total_ += r.refined;
-  log_.push_back({sim.step_count(), sim.time(), r.refined, r.shifted, level_counts(store)});
-  return r.refined > 0;
+  PassRecord rec;
+  rec.step = sim.step_count();
+  rec.time = sim.time();
+  if (any) {
+    const SplitResult r = split_marked(store, marks, settings_.pattern, settings_.rsp_k, settings_.max_level,
+                                       sim.settings().geometry.walls(), sim.time());
+    rec.refined = r.refined;
+    rec.shifted = r.shifted;
+  }
+  if (settings_.coarsening) {
+    // On the store as the split left it: daughters born in this pass are held by their level_time.
+    std::vector<std::uint8_t> may(store.size(), 0);
+    const double horizon = static_cast<double>(interval) * sim.dt();  // about the time to the next check
+    criterion_->mark_mergeable(store, horizon, may);
+    const double held_since = sim.time() - settings_.coarsening->hold_time;
+    for (std::size_t i = 0; i < store.size(); ++i) {
+      if (may[i] && store.level_time[i] > held_since) may[i] = 0;
+    }
+    const MergeResult m = merge_families(store, may, sim.settings().geometry, sim.time(),
+                                         [&](const Vec<2>& x, const Vec<2>& v) { return criterion_->would_split(x, v); });
+    rec.merged = m.merged;
+    rec.merge_d_kinetic = m.d_kinetic;
+    rec.merge_d_angular = m.d_angular;
+  }
+  if (rec.refined == 0 && rec.merged == 0) return false;
+  total_ += rec.refined;
+  total_merged_ += rec.merged;
+  rec.per_level = level_counts(store);
+  log_.push_back(std::move(rec));
+  return true;
 }
 
 RefinementStage& add_refinement_stage(Simulation& sim, const RefinementSettings& settings) {

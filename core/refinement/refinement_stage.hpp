@@ -1,12 +1,15 @@
 #pragma once
 // Dynamic refinement as a run-time stage: every check_interval steps, the criterion marks, the split pass
-// splits, and the solver rebuilds ghosts and grid and re-evaluates the rates (Simulation::run_stages).
+// splits, then (with coarsening) the families whose members all pass the merge test and have been at their
+// level for the hold time merge, and the solver rebuilds ghosts and grid and re-evaluates the rates
+// (Simulation::run_stages).
 // Static refinement at set-up (the paper's Fig. 1b) uses the same patterns and pass.
 #include <cstdint>
 #include <memory>
 #include <vector>
 
 #include "core/refinement/criteria.hpp"
+#include "core/refinement/merge_pass.hpp"
 #include "core/refinement/refinement_settings.hpp"
 #include "core/refinement/split_pass.hpp"
 #include "core/simulation.hpp"
@@ -19,6 +22,9 @@ struct PassRecord {
   double time = 0.0;
   std::size_t refined = 0;
   std::size_t shifted = 0;
+  std::size_t merged = 0;     // families merged (four into one)
+  double merge_d_kinetic = 0.0;  // kinetic energy the merges removed (J/m, <= 0)
+  double merge_d_angular = 0.0;  // change of L_z by the merges
   std::vector<std::size_t> per_level;  // fluid particles per level after the pass
 };
 
@@ -31,12 +37,14 @@ class RefinementStage final : public Stage {
   const RefinementSettings& settings() const { return settings_; }
   const std::vector<PassRecord>& log() const { return log_; }
   std::size_t total_refined() const { return total_; }
+  std::size_t total_merged() const { return total_merged_; }
 
  private:
   RefinementSettings settings_;
   std::unique_ptr<Criterion> criterion_;
   std::vector<PassRecord> log_;
   std::size_t total_ = 0;
+  std::size_t total_merged_ = 0;
 };
 
 /// Adds dynamic refinement to a simulation; returns the stage (owned by the simulation) for its log.

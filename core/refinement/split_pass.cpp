@@ -1,7 +1,10 @@
 #include "core/refinement/split_pass.hpp"
 
 #include <optional>
+#include <stdexcept>
+#include <string>
 
+#include "core/refinement/family.hpp"
 #include "core/refinement/patterns.hpp"
 #include "parallel/compaction.hpp"
 #include "parallel/parallel_for.hpp"
@@ -9,7 +12,7 @@
 namespace sph::refine {
 
 SplitResult split_marked(ParticleStore<2>& store, const std::vector<std::uint8_t>& marks, Pattern pattern,
-                         double rsp_k, int max_level, const std::vector<Wall2>& walls) {
+                         double rsp_k, int max_level, const std::vector<Wall2>& walls, double time) {
   const std::size_t n = store.size();
   auto splits = [&](std::size_t i) {
     return marks[i] != 0 && store.kind[i] == Kind::fluid && store.level[i] < max_level;
@@ -26,6 +29,13 @@ SplitResult split_marked(ParticleStore<2>& store, const std::vector<std::uint8_t
     // Still drop ghosts so the pass always leaves the same kind of store.
     store.compact([&](std::size_t i) { return store.kind[i] != Kind::ghost; });
     return result;
+  }
+  for (const std::uint32_t i : split_index) {  // a daughter's id must hold its generation and its path
+    const ParticleId id = store.id[i];
+    if (generation(id) >= kMaxGenerations || path(id) > (kPathMask >> 2)) {
+      throw std::length_error("split: particle id " + std::to_string(id) + " has no room for a daughter's id (" +
+                              std::to_string(kMaxGenerations) + " generations at most)");
+    }
   }
   std::vector<Offsets> offsets(count);
   std::vector<std::uint8_t> shifted(count, 0);
@@ -51,7 +61,6 @@ SplitResult split_marked(ParticleStore<2>& store, const std::vector<std::uint8_t
         return splits(i) ? 4u : 1u;
       },
       &out_offsets);
-  const ParticleId first_id = store.take_ids(4 * count);
   store.gather(src);
   auto s = store.view();
   par::parallel_for(count, [&](std::size_t r) {
@@ -60,6 +69,7 @@ SplitResult split_marked(ParticleStore<2>& store, const std::vector<std::uint8_t
     const Vec<2> xi = s.x[first];
     const double m = 0.25 * s.m[first], h = 0.5 * s.h[first], d = 0.5 * s.d[first];
     const std::int32_t level = s.level[first] + 1;
+    const ParticleId parent = s.id[first];
     for (std::size_t a = 0; a < 4; ++a) {
       const std::size_t k = first + a;
       s.x[k] = xi + offsets[r][a];
@@ -67,7 +77,9 @@ SplitResult split_marked(ParticleStore<2>& store, const std::vector<std::uint8_t
       s.h[k] = h;
       s.d[k] = d;
       s.level[k] = level;
-      s.id[k] = first_id + 4 * r + a;
+      s.id[k] = daughter_id(parent, static_cast<unsigned>(a));
+      s.level_time[k] = time;
+      s.origin[k] = Origin::split;
     }
   });
   return result;

@@ -89,6 +89,15 @@ enum class Slip { free_slip, no_slip };
 enum class Criterion { velocity, zone, few_neighbours };
 enum class Pattern { aap, rsp };
 
+/// Coarsening (effects.refinement.coarsening): a family of four daughters merges back into one particle
+/// when all four pass the criterion's merge test and have been at their level for hold_time.
+struct Coarsening {
+  double v_threshold = 5.0;  // velocity: merge below (the parser's default: half the split threshold)
+  int min_neighbours = 16;   // few_neighbours: merge at or above (the parser's default: twice the split count)
+  double hold_time = 0.5;    // s
+  bool operator==(const Coarsening&) const = default;
+};
+
 struct Refinement {
   Criterion criterion = Criterion::velocity;
   double v_threshold = 10.0;
@@ -98,6 +107,7 @@ struct Refinement {
   double rsp_k = 1.0;
   int check_interval = 100;
   int max_level = 1;
+  std::optional<Coarsening> coarsening;
   bool operator==(const Refinement&) const = default;
 };
 

@@ -26,6 +26,7 @@ refine::RefinementSettings refinement_settings(const Refinement& r) {
   s.rsp_k = r.rsp_k;
   s.check_interval = r.check_interval;
   s.max_level = r.max_level;
+  if (const auto& c = r.coarsening) s.coarsening = refine::CoarseningSettings{c->v_threshold, c->min_neighbours, c->hold_time};
   return s;
 }
 

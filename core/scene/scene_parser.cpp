@@ -201,6 +201,21 @@ Material parse_material(const Json& j, const std::string& path) {
   return m;
 }
 
+/// The merge test's key follows the split criterion's; its default is halfway to no refinement (half the
+/// split speed, twice the split neighbour count), so a family does not flip between the two.
+Coarsening parse_coarsening(const Json& j, const std::string& path, const Refinement& f) {
+  if (!j.is_object()) fail(path, std::string("must be an object (got ") + type_name(j) + ")");
+  std::vector<std::string> keys{"hold_time"};
+  if (f.criterion == Criterion::velocity) keys.emplace_back("v_threshold");
+  if (f.criterion == Criterion::few_neighbours) keys.emplace_back("min_neighbours");
+  ObjectReader r(j, path, keys, std::string("criterion ") + to_string(f.criterion));
+  Coarsening c;
+  if (f.criterion == Criterion::velocity) c.v_threshold = r.number("v_threshold", 0.5 * f.v_threshold);
+  if (f.criterion == Criterion::few_neighbours) c.min_neighbours = r.integer("min_neighbours", 2 * f.min_neighbours);
+  c.hold_time = r.number("hold_time", 0.5);
+  return c;
+}
+
 Refinement parse_refinement(const Json& j, const std::string& path) {
   if (!j.is_object()) fail(path, std::string("must be an object (got ") + type_name(j) + ")");
   Refinement f;
@@ -210,7 +225,7 @@ Refinement parse_refinement(const Json& j, const std::string& path) {
                                                           {"zone", Criterion::zone},
                                                           {"few_neighbours", Criterion::few_neighbours}})
                     : Criterion::velocity;
-  std::vector<std::string> keys{"criterion", "pattern", "rsp_k", "check_interval", "max_level"};
+  std::vector<std::string> keys{"criterion", "pattern", "rsp_k", "check_interval", "max_level", "coarsening"};
   switch (f.criterion) {
     case Criterion::velocity: keys.emplace_back("v_threshold"); break;
     case Criterion::zone: keys.emplace_back("zone"); break;
@@ -224,6 +239,7 @@ Refinement parse_refinement(const Json& j, const std::string& path) {
   f.rsp_k = r.number("rsp_k", 1.0);
   f.check_interval = r.integer("check_interval", 100);
   f.max_level = r.integer("max_level", 1);
+  if (r.has("coarsening")) f.coarsening = parse_coarsening(r.at("coarsening"), r.path("coarsening"), f);
   return f;
 }
 

@@ -204,6 +204,19 @@ void validate_scene(const Scene& s) {
     if (r.max_level < 1 || r.max_level > kMaxLevel) {
       fail(p + ".max_level", "must be between 1 and " + std::to_string(kMaxLevel) + " (got " + std::to_string(r.max_level) + ")");
     }
+    if (const auto& c = r.coarsening) {
+      const std::string q = p + ".coarsening";
+      if (r.criterion == Criterion::velocity && !(c->v_threshold > 0.0 && c->v_threshold < r.v_threshold)) {
+        fail(q + ".v_threshold", "must be above 0 and below the split threshold " + num(r.v_threshold) +
+                                     " m/s, or a family could split and merge at alternate checks (got " + num(c->v_threshold) + ")");
+      }
+      if (r.criterion == Criterion::few_neighbours && c->min_neighbours <= r.min_neighbours) {
+        fail(q + ".min_neighbours", "must be above the split count " + std::to_string(r.min_neighbours) +
+                                        ", or a family could split and merge at alternate checks (got " +
+                                        std::to_string(c->min_neighbours) + ")");
+      }
+      if (!(c->hold_time >= 0.0 && std::isfinite(c->hold_time))) fail(q + ".hold_time", "must be 0 s or more (got " + num(c->hold_time) + ")");
+    }
   }
   if (e.static_refinement) {
     if (e.static_refinement->box) valid_rect(*e.static_refinement->box, "effects.static_refinement.box");

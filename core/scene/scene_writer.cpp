@@ -78,6 +78,13 @@ Json scene_to_json(const Scene& s) {
     o["rsp_k"] = r.rsp_k;
     o["check_interval"] = r.check_interval;
     o["max_level"] = r.max_level;
+    if (const auto& c = r.coarsening) {
+      Json co;
+      if (r.criterion == Criterion::velocity) co["v_threshold"] = c->v_threshold;
+      if (r.criterion == Criterion::few_neighbours) co["min_neighbours"] = c->min_neighbours;
+      co["hold_time"] = c->hold_time;
+      o["coarsening"] = co;
+    }
     e["refinement"] = o;
   }
   if (fx.static_refinement) {

@@ -1,0 +1,146 @@
+#include "core/refinement/merge_pass.hpp"
+
+#include <algorithm>
+#include <array>
+
+#include "core/refinement/family.hpp"
+#include "parallel/parallel_for.hpp"
+
+namespace sph::refine {
+
+namespace {
+
+double cross(const Vec<2>& a, const Vec<2>& b) { return a[0] * b[1] - a[1] * b[0]; }
+
+/// True when x is in the fluid domain and at least `margin` from every wall it projects onto.
+bool clear_of_walls(const Vec<2>& x, const Geometry2& geometry, const std::vector<Wall2>& walls, double margin) {
+  if (!geometry.in_fluid_domain(x)) return false;
+  for (const Wall2& w : walls) {
+    const double dist = w.signed_distance(x);
+    if (dist > -margin && dist < margin && w.projects_onto(x, margin)) return false;
+  }
+  return true;
+}
+
+struct Candidate {
+  ParticleId parent;
+  unsigned sibling;
+  std::uint32_t index;
+};
+
+struct FamilyOutcome {
+  std::array<std::uint32_t, 4> members{};  // store indices in sibling order
+  std::uint32_t keeper = 0;                // the lowest store index: the merged particle goes there
+  int verdict = 0;                         // 0 merged, 1 off walls, 2 would split again
+  double d_kinetic = 0.0, d_angular = 0.0;
+  // The merged state.
+  Vec<2> x = Vec<2>::Zero(), v = Vec<2>::Zero(), vh = Vec<2>::Zero();
+  double m = 0, rho = 0, rhoh = 0;
+};
+
+}  // namespace
+
+MergeResult merge_families(ParticleStore<2>& store, const std::vector<std::uint8_t>& may_merge,
+                           const Geometry2& geometry, double time,
+                           const std::function<bool(const Vec<2>&, const Vec<2>&)>& would_split) {
+  MergeResult result;
+  const std::size_t n = store.size();
+  std::vector<Candidate> cand;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!may_merge[i] || store.kind[i] != Kind::fluid || !has_parent(store.id[i])) continue;
+    cand.push_back({parent_id(store.id[i]), sibling_index(store.id[i]), static_cast<std::uint32_t>(i)});
+  }
+  // (parent, sibling) is unique among live particles, so the sorted order is fixed by the data.
+  std::sort(cand.begin(), cand.end(), [](const Candidate& a, const Candidate& b) {
+    return a.parent != b.parent ? a.parent < b.parent : a.sibling < b.sibling;
+  });
+  std::vector<FamilyOutcome> fam;
+  for (std::size_t k = 0; k + 3 < cand.size();) {
+    if (cand[k + 3].parent != cand[k].parent) {
+      ++k;
+      continue;
+    }
+    FamilyOutcome f;
+    for (unsigned a = 0; a < 4; ++a) f.members[a] = cand[k + a].index;
+    f.keeper = *std::min_element(f.members.begin(), f.members.end());
+    fam.push_back(f);
+    k += 4;
+  }
+  if (fam.empty()) return result;
+
+  const std::vector<Wall2> walls = geometry.walls();
+  par::parallel_for(fam.size(), [&](std::size_t r) {
+    FamilyOutcome& f = fam[r];
+    double m = 0.0, vol = 0.0, volh = 0.0, ke = 0.0, lz = 0.0;
+    Vec<2> mx = Vec<2>::Zero(), mv = Vec<2>::Zero(), mvh = Vec<2>::Zero();
+    for (const std::uint32_t i : f.members) {  // sibling order: a fixed summation order
+      const double mi = store.m[i];
+      m += mi;
+      mx += mi * store.x[i];
+      mv += mi * store.v[i];
+      mvh += mi * store.vh[i];
+      vol += mi / store.rho[i];
+      volh += mi / store.rhoh[i];
+      ke += 0.5 * mi * store.v[i].squaredNorm();
+      lz += mi * cross(store.x[i], store.v[i]);
+    }
+    f.m = m;
+    f.x = mx / m;
+    f.v = mv / m;
+    f.vh = mvh / m;
+    f.rho = m / vol;
+    f.rhoh = m / volh;
+    const double d_merged = 2.0 * store.d[f.members[0]];
+    if (!clear_of_walls(f.x, geometry, walls, 0.125 * d_merged)) {
+      f.verdict = 1;
+    } else if (would_split && would_split(f.x, f.v)) {
+      f.verdict = 2;
+    }
+    f.d_kinetic = 0.5 * m * f.v.squaredNorm() - ke;
+    f.d_angular = m * cross(f.x, f.v) - lz;
+  });
+
+  std::vector<std::uint8_t> drop(n, 0);
+  for (const FamilyOutcome& f : fam) {  // serial, in family order: the reported sums are deterministic
+    if (f.verdict == 1) {
+      ++result.kept_off_walls;
+      continue;
+    }
+    if (f.verdict == 2) {
+      ++result.kept_by_criterion;
+      continue;
+    }
+    ++result.merged;
+    result.d_kinetic += f.d_kinetic;
+    result.d_angular += f.d_angular;
+    for (const std::uint32_t i : f.members) drop[i] = i != f.keeper;
+  }
+  if (result.merged == 0) return result;
+
+  auto s = store.view();
+  par::parallel_for(fam.size(), [&](std::size_t r) {
+    const FamilyOutcome& f = fam[r];
+    if (f.verdict != 0) return;
+    const std::size_t k = f.keeper;
+    const ParticleId child = s.id[f.members[0]];
+    s.x[k] = f.x;
+    s.v[k] = f.v;
+    s.vh[k] = f.vh;
+    s.m[k] = f.m;
+    s.rho[k] = f.rho;
+    s.rhoh[k] = f.rhoh;
+    s.h[k] = 2.0 * s.h[f.members[0]];  // powers of two: the parent's h and d exactly
+    s.d[k] = 2.0 * s.d[f.members[0]];
+    s.level[k] = s.level[f.members[0]] - 1;
+    s.id[k] = parent_id(child);
+    s.level_time[k] = time;
+    s.origin[k] = Origin::fresh_merge;
+    s.a[k].setZero();  // the rates are re-evaluated after the pass
+    s.drho[k] = 0.0;
+  });
+  // Ghosts go too, as in the split pass: the solver rebuilds them for the new set.
+  store.compact([&](std::size_t i) { return drop[i] == 0 && store.kind[i] != Kind::ghost; });
+  return result;
+}
+
+}  // namespace sph::refine

@@ -1,0 +1,40 @@
+#pragma once
+// The merge pass between steps (coarsening, the inverse of the split pass): the four daughters of one parent
+// become one particle again when all four may merge. Families are found through the ids
+// (core/refinement/family.hpp): candidates sorted by parent id, four consecutive with one parent form a family.
+// The merged particle takes the parent's id, level, spacing and smoothing length back, and sits where the
+// lowest store index of the family sat; the three others leave by one stream compaction. The order of the
+// store and every sum (sibling order) are fixed by the data, so the result is the same at any thread count.
+//
+// Merged state: mass M = sum m_a; position and velocity (and the half-step velocity) the mass-weighted means,
+// so mass and linear momentum are kept exactly (to rounding); density M / sum (m_a / rho_a), so the volume
+// is kept. What one particle cannot hold is the family's motion about its centre of mass: the merge removes
+// the kinetic energy sum 1/2 m_a |v_a - V|^2 and the angular momentum sum m_a (x_a - X) x (v_a - V); the pass
+// reports both.
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "core/boundary/wall.hpp"
+#include "core/particle_store.hpp"
+
+namespace sph::refine {
+
+struct MergeResult {
+  std::size_t merged = 0;            // families merged (each four particles into one)
+  std::size_t kept_off_walls = 0;    // complete families left alone: their centre of mass was too close to a wall
+  std::size_t kept_by_criterion = 0; // complete families left alone: the merged particle would be split again
+  double d_kinetic = 0.0;            // kinetic energy after - before (J/m), <= 0
+  double d_angular = 0.0;            // angular momentum L_z after - before (kg m^2/s per m)
+};
+
+/// Merges every family whose four members are fluid and have may_merge[i] != 0 (may_merge has store.size()
+/// entries). A family is left alone when its centre of mass is outside the fluid domain or closer to a wall
+/// than an eighth of the merged spacing (the split pass's margin for the family's daughters), or when
+/// `would_split(X, V)` says the merged particle would be marked for a split at once. `time` is written as
+/// the merged particle's level_time.
+MergeResult merge_families(ParticleStore<2>& store, const std::vector<std::uint8_t>& may_merge,
+                           const Geometry2& geometry, double time,
+                           const std::function<bool(const Vec<2>&, const Vec<2>&)>& would_split = {});
+
+}  // namespace sph::refine

@@ -1,0 +1,323 @@
+// Coarsening: families of daughters merging back into their parent (core/refinement/merge_pass.hpp).
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <map>
+#include <numeric>
+#include <random>
+#include <set>
+
+#include "core/case_builder.hpp"
+#include "core/refinement/family.hpp"
+#include "core/refinement/merge_pass.hpp"
+#include "core/refinement/refinement_stage.hpp"
+#include "core/refinement/split_pass.hpp"
+#include "core/setup.hpp"
+#include "tests/support/test_scale.hpp"
+
+namespace {
+
+using namespace sph;
+using refine::Pattern;
+
+double cross(const Vec<2>& a, const Vec<2>& b) { return a[0] * b[1] - a[1] * b[0]; }
+
+Geometry2 open_box(double w, double h) {
+  Geometry2 g;
+  g.container = {Vec<2>(0, 0), Vec<2>(w, h)};
+  return g;
+}
+
+ParticleStore<2> lattice_store(const Vec<2>& lo, const Vec<2>& hi, double d) {
+  ParticleStore<2> s;
+  FluidBlockSpec spec;
+  spec.spacing = d;
+  add_fluid(s, lattice_rectangle(lo, hi, d), spec, 1000.0);
+  return s;
+}
+
+std::vector<std::uint8_t> all_of(const ParticleStore<2>& s) { return std::vector<std::uint8_t>(s.size(), 1); }
+
+// Brute-force twin of the merge's bookkeeping: totals over the fluid.
+struct Totals {
+  double mass = 0, ke = 0, lz = 0;
+  Vec<2> P = Vec<2>::Zero();
+};
+Totals totals(const ParticleStore<2>& s) {
+  Totals t;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] != Kind::fluid) continue;
+    t.mass += s.m[i];
+    t.ke += 0.5 * s.m[i] * s.v[i].squaredNorm();
+    t.P += s.m[i] * s.v[i];
+    t.lz += s.m[i] * cross(s.x[i], s.v[i]);
+  }
+  return t;
+}
+
+TEST(Family, DaughterIdsNameTheirParentAndSiblingAndStayUnique) {
+  std::set<ParticleId> seen;
+  for (ParticleId root : {ParticleId{0}, ParticleId{1}, ParticleId{5}, refine::kMaxRootId - 1}) {
+    ParticleId id = root;
+    for (int g = 0; g < refine::kMaxGenerations; ++g) {
+      for (unsigned a = 0; a < 4; ++a) {
+        const ParticleId c = refine::daughter_id(id, a);
+        EXPECT_TRUE(refine::has_parent(c));
+        EXPECT_EQ(refine::parent_id(c), id);
+        EXPECT_EQ(refine::sibling_index(c), a);
+        EXPECT_EQ(refine::generation(c), g + 1);
+        EXPECT_TRUE(seen.insert(c).second) << "id " << c << " handed out twice";
+      }
+      id = refine::daughter_id(id, static_cast<unsigned>(g % 4));
+    }
+  }
+  EXPECT_FALSE(refine::has_parent(12345));
+}
+
+TEST(Coarsening, SplitThenMergeOfAnUndisturbedLatticeGivesTheLatticeBack) {
+  for (Pattern p : {Pattern::aap, Pattern::rsp}) {
+    // Against walls on three sides: AAP daughters of the wall rows sit d/4 from the wall, and merge back.
+    const double d = 0.5;
+    const Geometry2 g = open_box(6.0, 10.0);
+    ParticleStore<2> s = lattice_store(Vec<2>(0, 0), Vec<2>(6.0, 4.0), d);
+    const ParticleStore<2> original = s;
+    refine::split_marked(s, all_of(s), p, 1.0, 5, g.walls(), 1.0);
+    ASSERT_EQ(s.size(), 4 * original.size());
+    const refine::MergeResult r = refine::merge_families(s, all_of(s), g, 2.0);
+    EXPECT_EQ(r.merged, original.size());
+    EXPECT_EQ(r.kept_off_walls, 0u);
+    ASSERT_EQ(s.size(), original.size());
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      // The family's centre of mass is its parent's position up to the rounding of four offsets.
+      EXPECT_LE((s.x[i] - original.x[i]).norm(), 1e-12 * 6.0) << i;
+      EXPECT_EQ(s.id[i], original.id[i]);
+      EXPECT_EQ(s.m[i], original.m[i]);  // m/4 four times: exact in binary
+      EXPECT_EQ(s.h[i], original.h[i]);
+      EXPECT_EQ(s.d[i], original.d[i]);
+      EXPECT_EQ(s.level[i], original.level[i]);
+      EXPECT_NEAR(s.rho[i], original.rho[i], 1e-12 * original.rho[i]);
+      EXPECT_EQ(s.v[i], original.v[i]);
+      EXPECT_EQ(s.level_time[i], 2.0);
+    }
+  }
+}
+
+// A disturbed family: the daughters moved apart and got different velocities since their split.
+ParticleStore<2> disturbed_families(std::size_t parents, unsigned seed, int levels) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(-0.5, 0.5);
+  ParticleStore<2> s = lattice_store(Vec<2>(1, 1), Vec<2>(1 + 0.5 * std::sqrt(double(parents)), 9), 0.5);
+  const Geometry2 g = open_box(20, 20);
+  for (int l = 0; l < levels; ++l) refine::split_marked(s, all_of(s), Pattern::aap, 1.0, 8, g.walls(), 0.0);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    s.x[i] += 0.2 * s.d[i] * Vec<2>(U(rng), U(rng));
+    s.v[i] = Vec<2>(3.0 * U(rng) + 1.0, 3.0 * U(rng));
+    s.vh[i] = s.v[i] + Vec<2>(U(rng), U(rng)) * 0.1;
+    s.rho[i] = 1000.0 * (1.0 + 0.02 * U(rng));
+    s.rhoh[i] = s.rho[i];
+  }
+  return s;
+}
+
+TEST(Coarsening, EveryMergeKeepsMassAndMomentumAndReportsWhatItRemoves) {
+  ParticleStore<2> s = disturbed_families(64, 3, 2);
+  const Geometry2 g = open_box(20, 20);
+  for (int pass = 0; pass < 2; ++pass) {  // level 2 -> 1, then 1 -> 0
+    const Totals before = totals(s);
+    double sP = 0, sL = 0;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      sP += s.m[i] * s.v[i].norm();
+      sL += s.m[i] * s.x[i].norm() * s.v[i].norm();
+    }
+    const std::size_t n = s.size();
+    const refine::MergeResult r = refine::merge_families(s, all_of(s), g, 1.0);
+    EXPECT_EQ(r.merged, n / 4);
+    const Totals after = totals(s);
+    EXPECT_NEAR(after.mass, before.mass, 1e-12 * before.mass);  // sums in a different order: rounding only
+    EXPECT_LE((after.P - before.P).norm(), 1e-12 * sP);
+    // What the pass reports is what the totals say it removed.
+    EXPECT_NEAR(r.d_kinetic, after.ke - before.ke, 1e-12 * before.ke);
+    EXPECT_NEAR(r.d_angular, after.lz - before.lz, 1e-12 * sL);
+    EXPECT_LT(r.d_kinetic, 0.0) << "the motion about the centre of mass is lost, never gained";
+  }
+}
+
+TEST(Coarsening, FamiliesAreFoundWhereverTheirMembersSitAndOnlyWhenAllFourMayMerge) {
+  ParticleStore<2> s = disturbed_families(16, 5, 1);
+  const std::size_t n = s.size();
+  // Scatter the store (the step reorders it by cells) and hold one member of the first family back.
+  std::vector<std::uint32_t> perm(n);
+  std::iota(perm.begin(), perm.end(), 0u);
+  std::shuffle(perm.begin(), perm.end(), std::mt19937_64(9));
+  s.gather(perm);
+  std::vector<std::uint8_t> may = all_of(s);
+  const ParticleId held_parent = refine::parent_id(s.id[0]);
+  may[0] = 0;
+  const refine::MergeResult r = refine::merge_families(s, may, open_box(20, 20), 1.0);
+  EXPECT_EQ(r.merged, n / 4 - 1);
+  std::size_t held = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (refine::has_parent(s.id[i])) {
+      EXPECT_EQ(refine::parent_id(s.id[i]), held_parent);
+      ++held;
+    }
+  }
+  EXPECT_EQ(held, 4u);
+}
+
+TEST(Coarsening, AFamilyWhoseCentreWouldSitInAWallOrAnObstacleStaysSplit) {
+  Geometry2 g = open_box(10, 10);
+  g.obstacles.push_back({Vec<2>(4, 0), Vec<2>(6, 2)});
+  const double d = 0.5;
+  // Families split from parents at the lattice distance from walls and corners merge back inside.
+  for (const Vec<2>& xi : {Vec<2>(d / 2, d / 2), Vec<2>(4 - d / 2, 1), Vec<2>(6 + d / 2, 2 + d / 2), Vec<2>(5, 2 + d / 2)}) {
+    ParticleStore<2> s = lattice_store(xi - Vec<2>(d / 2, d / 2), xi + Vec<2>(d / 2, d / 2), d);
+    ASSERT_EQ(s.size(), 1u);
+    s.x[0] = xi;
+    refine::split_marked(s, all_of(s), Pattern::aap, 1.0, 5, g.walls(), 0.0);
+    const refine::MergeResult r = refine::merge_families(s, all_of(s), g, 1.0);
+    EXPECT_EQ(r.merged, 1u) << xi.transpose();
+    ASSERT_EQ(s.size(), 1u);
+    EXPECT_TRUE(g.in_fluid_domain(s.x[0]));
+    EXPECT_GE(g.distance_to_walls(s.x[0]), d / 8);
+  }
+  // A family that has wrapped round the obstacle's corner: its centre of mass lies inside the obstacle.
+  ParticleStore<2> s = lattice_store(Vec<2>(0, 0), Vec<2>(d, d), d);
+  refine::split_marked(s, all_of(s), Pattern::aap, 1.0, 5, {}, 0.0);
+  ASSERT_EQ(s.size(), 4u);
+  const Vec<2> corner(6, 2);
+  s.x[0] = corner + Vec<2>(0.1, 0.3);
+  s.x[1] = corner + Vec<2>(0.3, 0.1);
+  s.x[2] = corner + Vec<2>(-0.9, 0.1);
+  s.x[3] = corner + Vec<2>(0.1, -0.9);
+  for (std::size_t i = 0; i < 4; ++i) ASSERT_TRUE(g.in_fluid_domain(s.x[i]));
+  const refine::MergeResult r = refine::merge_families(s, all_of(s), g, 1.0);
+  EXPECT_EQ(r.merged, 0u);
+  EXPECT_EQ(r.kept_off_walls, 1u);
+  EXPECT_EQ(s.size(), 4u);
+}
+
+bool same_state(const ParticleStore<2>& a, const ParticleStore<2>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a.x[i] != b.x[i] || a.v[i] != b.v[i] || a.rho[i] != b.rho[i] || a.m[i] != b.m[i] || a.id[i] != b.id[i] ||
+        a.level_time[i] != b.level_time[i] || a.vh[i] != b.vh[i] || a.rhoh[i] != b.rhoh[i])
+      return false;
+  }
+  return true;
+}
+
+TEST(Coarsening, MergeIsBitwiseIndependentOfTheThreadCount) {
+  const int threads = omp_get_max_threads();
+  const ParticleStore<2> base = disturbed_families(4096, 13, 1);
+  std::vector<std::uint8_t> may(base.size(), 0);
+  for (std::size_t i = 0; i < base.size(); ++i) may[i] = base.v[i][0] > 0.0;  // some families complete, some not
+  ParticleStore<2> one = base, two = base;
+  omp_set_num_threads(1);
+  const auto r1 = refine::merge_families(one, may, open_box(200, 20), 1.0);
+  omp_set_num_threads(2);
+  const auto r2 = refine::merge_families(two, may, open_box(200, 20), 1.0);
+  omp_set_num_threads(threads);
+  EXPECT_GT(r1.merged, 0u);
+  EXPECT_LT(r1.merged, base.size() / 4);
+  EXPECT_EQ(r1.merged, r2.merged);
+  EXPECT_EQ(r1.d_kinetic, r2.d_kinetic);
+  EXPECT_EQ(r1.d_angular, r2.d_angular);
+  EXPECT_TRUE(same_state(one, two));
+}
+
+// The refinement stage on a still tank: a velocity field set by hand marks a block, the block is split, the
+// water is then set at rest, and once the hold time has passed the block merges back to the original set.
+TEST(Coarsening, ARegionThatStopsBeingRefinedReturnsToTheOriginalParticles) {
+  refine::RefinementSettings rs;
+  rs.criterion = refine::CriterionKind::velocity;
+  rs.v_threshold = 1.0;
+  rs.check_interval = 1;
+  rs.max_level = 2;
+  rs.coarsening = refine::CoarseningSettings{0.5, 16, 0.3};
+  TankSpec spec;
+  Simulation sim = make_still_tank(spec);
+  refine::RefinementStage& stage = refine::add_refinement_stage(sim, rs);
+  auto fluid_ids = [&] {
+    std::vector<ParticleId> ids;
+    for (std::size_t i = 0; i < sim.store().size(); ++i)
+      if (sim.store().kind[i] == Kind::fluid) ids.push_back(sim.store().id[i]);
+    std::sort(ids.begin(), ids.end());
+    return ids;
+  };
+  const std::vector<ParticleId> original = fluid_ids();
+  const Box2 block{Vec<2>(8, 2), Vec<2>(14, 6)};
+  auto set_speed = [&](double u) {
+    auto& s = sim.store();
+    for (std::size_t i = 0; i < s.size(); ++i)
+      if (s.kind[i] == Kind::fluid && block.contains(s.x[i])) s.v[i] = Vec<2>(u, 0.0);
+  };
+  set_speed(2.0);
+  sim.set_clock(0.0, 0, sim.dt());
+  sim.run_stages();  // level 0 -> 1
+  set_speed(2.0);
+  sim.set_clock(0.1, 1, sim.dt());
+  sim.run_stages();  // level 1 -> 2
+  const std::size_t refined = fluid_ids().size();
+  EXPECT_GT(refined, original.size() + 3 * 16 * 3);
+  for (std::size_t i = 0; i < sim.store().size(); ++i) sim.store().v[i].setZero();  // daughters outside the block too
+  sim.set_clock(0.2, 2, sim.dt());
+  sim.run_stages();
+  EXPECT_EQ(fluid_ids().size(), refined) << "held: the level-2 daughters were born 0.1 s ago";
+  sim.set_clock(0.41, 3, sim.dt());
+  sim.run_stages();  // level 2 -> 1: those born at 0.1 s
+  EXPECT_LT(fluid_ids().size(), refined);
+  EXPECT_GT(fluid_ids().size(), original.size()) << "the merged level-1 particles are held again";
+  sim.set_clock(0.72, 4, sim.dt());
+  sim.run_stages();  // level 1 -> 0
+  EXPECT_EQ(fluid_ids(), original);
+  EXPECT_EQ(stage.total_merged(), (refined - original.size()) / 3);
+}
+
+// In a dam break with coarsening no family flips: a parent split at one check is not merged at the next, and a
+// family merged at one check is not split at the next.
+TEST(Coarsening, NoFamilyFlipsBetweenSplitAndMergeFromOneCheckToTheNext) {
+  DamBreakSpec spec;
+  refine::RefinementSettings r;
+  r.v_threshold = 8.0;
+  r.check_interval = 20;
+  r.coarsening = refine::CoarseningSettings{4.0, 16, 0.0};  // no hold: only the hysteresis keeps them apart
+  spec.refinement = r;
+  Simulation sim = make_dam_break(spec);
+  const double end = (test::short_runs() ? 1.0 : 2.5) * std::sqrt(spec.column_height / 9.81);
+  std::set<ParticleId> parents_before;  // ids of level-0 particles before a check
+  std::set<ParticleId> split_last, merged_last;
+  std::size_t splits = 0, merges = 0;
+  auto level0 = [&] {
+    std::set<ParticleId> ids;
+    for (std::size_t i = 0; i < sim.store().size(); ++i)
+      if (sim.store().kind[i] == Kind::fluid && sim.store().level[i] == 0) ids.insert(sim.store().id[i]);
+    return ids;
+  };
+  while (sim.time() < end) {
+    sim.step();
+    if (sim.step_count() % 20 != 0) {
+      sim.run_stages();
+      continue;
+    }
+    const std::set<ParticleId> before = level0();
+    sim.run_stages();
+    const std::set<ParticleId> after = level0();
+    std::set<ParticleId> split_now, merged_now;
+    std::set_difference(before.begin(), before.end(), after.begin(), after.end(), std::inserter(split_now, split_now.end()));
+    std::set_difference(after.begin(), after.end(), before.begin(), before.end(), std::inserter(merged_now, merged_now.end()));
+    for (ParticleId id : split_now) EXPECT_FALSE(merged_last.count(id)) << "merged, then split at the next check: " << id;
+    for (ParticleId id : merged_now) EXPECT_FALSE(split_last.count(id)) << "split, then merged at the next check: " << id;
+    splits += split_now.size();
+    merges += merged_now.size();
+    split_last = split_now;
+    merged_last = merged_now;
+  }
+  EXPECT_GT(splits, 0u);
+  EXPECT_GT(merges, 0u);
+}
+
+}  // namespace
