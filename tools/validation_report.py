@@ -45,9 +45,12 @@ def read_csv(path):
     return {n: data[:, i] for i, n in enumerate(names)}
 
 
-def refinement(pattern="aap", v=10.0, k=1.0, max_level=1):
-    return json.dumps({"criterion": "velocity", "v_threshold": v, "pattern": pattern, "rsp_k": k,
-                       "check_interval": 100, "max_level": max_level})
+def refinement(pattern="aap", v=10.0, k=1.0, max_level=1, coarsening=False):
+    r = {"criterion": "velocity", "v_threshold": v, "pattern": pattern, "rsp_k": k, "check_interval": 100,
+         "max_level": max_level}
+    if coarsening:
+        r["coarsening"] = {}  # the defaults: merge below v / 2, after 0.5 s at the level (docs/SCENES.md)
+    return json.dumps(r)
 
 
 STATIC = json.dumps({"pattern": "aap"})
@@ -68,6 +71,10 @@ def variants_for(case, scene, spacings, threshold, quick):
         v.append((f"refined{tag}", res + [f"effects.static_refinement={STATIC}"], k))
         v.append((f"aap{tag}", res + [f"effects.refinement={refinement('aap', threshold)}"], k))
         v.append((f"rsp{tag}", res + [f"effects.refinement={refinement('rsp', threshold, 1.0)}"], k))
+        if k < 4:  # refinement and coarsening, at the paper's count and at 4x
+            for pat in ("aap", "rsp"):
+                v.append((f"{pat}_coarsen{tag}",
+                          res + [f"effects.refinement={refinement(pat, threshold, 1.0, coarsening=True)}"], k))
         if k == 1:
             v.append(("rsp_k0.5", [f"effects.refinement={refinement('rsp', threshold, 0.5)}"], k))
             for f in (0.5, 1.5, 2.0):
@@ -141,6 +148,26 @@ def particle_steps(series):
 
 
 # ----------------------------------------------------------------------------------------------- figures
+def count_chart(case, R, time_scale, xlabel, out_png, title):
+    """Fluid particles over time: the fully refined run, and the dynamic runs with and without coarsening."""
+    fig, axes = plt.subplots(1, 2, figsize=(11, 3.8), sharey=False)
+    for ax, tag in zip(axes, ("", "_x4")):
+        for name, style in (("refined", "k-"), ("aap", "C0-"), ("aap_coarsen", "C0--"), ("rsp", "C1-"),
+                            ("rsp_coarsen", "C1--"), ("unrefined", "k:")):
+            if name + tag in R:
+                s = R[name + tag]["series"]
+                ax.plot(s["time"] * time_scale, s["fluid"], style, label=name + tag)
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel("fluid particles")
+        ax.set_yscale("log")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(out_png, dpi=110)
+    plt.close(fig)
+
+
 def speed_snapshots(case, runs, names, times, norm_t, out_png, xlim, ylim):
     """Particles coloured by speed at several times, one row per variant (like the paper's Fig. 3 and 6)."""
     import h5py
@@ -379,6 +406,9 @@ def main():
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--skip-runs", action="store_true")
     ap.add_argument("--only", default="", help="comma-separated cases to rerun; the others' stored runs are reused")
+    ap.add_argument("--variants", default="",
+                    help="comma-separated variant names to rerun (in every case that has them); the others' stored "
+                         "runs are reused")
     ap.add_argument("--retime-short", action="store_true",
                     help=f"rerun only the stored variants shorter than {SHORT_RUN_S:g} s (best of {REPEATS_SHORT})")
     args = ap.parse_args()
@@ -418,6 +448,12 @@ def main():
         if unknown:
             sys.exit(f"--only: unknown case(s) {', '.join(sorted(unknown))}")
         selected = [j for j in jobs if not only or j[0] in only]
+        wanted = {v for v in args.variants.split(",") if v}
+        if wanted:
+            unknown = wanted - {j[2] for j in jobs}
+            if unknown:
+                sys.exit(f"--variants: unknown variant(s) {', '.join(sorted(unknown))}")
+            selected = [j for j in selected if j[2] in wanted]
         if args.retime_short:
             def stored_wall(j):
                 out = os.path.join(RESULTS, j[0], j[2])
@@ -487,9 +523,11 @@ def main():
         if "rsp" in R and "refined" in R:
             speed_snapshots("dam_break", R, ["rsp", "refined"], [0.5, 1.0, 1.5, 2.0], 1.0 / T,
                             os.path.join(FIGURES, "validation_dam_snapshots.png"), (0, 50), (0, 40))
+        count_chart("dam_break", R, 1.0 / T, "t sqrt(g / H0)", os.path.join(FIGURES, "validation_dam_count.png"),
+                    "Breaking dam: particles over time, with and without coarsening (dashed)")
         md.append("## Breaking dam (the paper's 25 m square column)\n")
         md.append("![H and Z](figures/validation_dam_HZ.png)\n\n![cost](figures/validation_dam_cost.png)\n\n"
-                  "![snapshots](figures/validation_dam_snapshots.png)\n")
+                  "![snapshots](figures/validation_dam_snapshots.png)\n\n![count](figures/validation_dam_count.png)\n")
         md.append(table(rows, [("variant", lambda r: r["name"]), ("wall s", lambda r: r["wall"]),
                                ("steps", lambda r: r["steps"]), ("mean N", lambda r: r["mean_n"]),
                                ("final N", lambda r: r["final_n"]), ("time / refined", lambda r: r["rel_time"]),
@@ -534,9 +572,11 @@ def main():
         if "rsp" in R and "refined" in R:
             speed_snapshots("drop", R, ["rsp", "refined"], [0.5, 1.0, 2.0, 3.0], 1.0,
                             os.path.join(FIGURES, "validation_drop_snapshots.png"), (-12.5, 12.5), (0, 16))
+        count_chart("drop", R, 1.0, "t (s)", os.path.join(FIGURES, "validation_drop_count.png"),
+                    "Splash of a drop: particles over time, with and without coarsening (dashed)")
         md.append("## Splash of a drop\n")
         md.append("![H](figures/validation_drop_H.png)\n\n![cost](figures/validation_drop_cost.png)\n\n"
-                  "![snapshots](figures/validation_drop_snapshots.png)\n")
+                  "![snapshots](figures/validation_drop_snapshots.png)\n\n![count](figures/validation_drop_count.png)\n")
         md.append(table(rows, [("variant", lambda r: r["name"]), ("wall s", lambda r: r["wall"]),
                                ("steps", lambda r: r["steps"]), ("mean N", lambda r: r["mean_n"]),
                                ("final N", lambda r: r["final_n"]), ("time / refined", lambda r: r["rel_time"]),

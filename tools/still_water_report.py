@@ -1,0 +1,143 @@
+#!/usr/bin/python3
+"""Still water under refinement (issue: a split the flow does not notice): the still tank
+(cases/still_tank.json, 25 m x 10 m, hydrostatic start, free-slip ghost walls) run for 30 s unrefined and
+with a zone refined, for AAP and RSP, one and two levels, and zones in the bulk, at a wall and in a corner.
+
+    /usr/bin/python3 tools/still_water_report.py [--jobs 2] [--end 30] [--set KEY=VALUE ...] [--skip-runs]
+                                                 [--only NAME[,NAME]] [--out results/still_water]
+
+--set applies to every run (e.g. a candidate remedy's scene key), so one command compares a remedy with the
+paper's scheme. Prints one markdown table: per run its status, max |v| over the run and over the window,
+the time-averaged pressure per 1 m layer against the unrefined run's, and the fluid count after the first
+pass and at the end. Figures:
+  - max |v|: the largest speed over (0, end], and the mean of the per-row largest speed over the window
+    [end/3, end] (an oscillating quantity: a time average over a stated window);
+  - pressure per layer: fluid particles binned in 1 m layers from the floor, their mean pressure averaged
+    over the frames in the window; the table gives the largest |p - p_unrefined| / p_unrefined over the
+    layers below 9 m (the top layer's pressure is near zero, so a relative error means nothing there), and
+    the same normalised by rho g H at the floor;
+  - creep: the fluid count at the first output after the first pass (t >= 1 s) and at the end.
+Exit status 0 when every run completed; 1 when one failed.
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+APP = os.path.join(ROOT, "build", "release", "app", "sphrefine")
+SCENE = os.path.join(ROOT, "cases", "still_tank.json")
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+from read_output import frame_files, load_frame, load_series  # noqa: E402
+
+RHO0, G, DEPTH = 1000.0, 9.81, 10.0
+ZONES = {  # m; the tank is [0, 25] x [0, 10]
+    "bulk": {"lo": [10, 3], "hi": [15, 7]},
+    "wall": {"lo": [0, 3], "hi": [4, 7]},
+    "corner": {"lo": [0, 0], "hi": [5, 4]},
+}
+
+
+def variants():
+    v = [("unrefined", None)]
+    for zone in ZONES:
+        for pattern in ("aap", "rsp"):
+            for levels in (1, 2):
+                r = {"criterion": "zone", "zone": ZONES[zone], "pattern": pattern, "check_interval": 100,
+                     "max_level": levels}
+                v.append((f"{zone}_{pattern}_L{levels}", r))
+    return v
+
+
+def run(job, out_root, end, extra):
+    name, refinement = job
+    out = os.path.join(out_root, name)
+    cmd = [APP, "run", SCENE, "-o", out, "--force", "-q", "--threads", "1", "--set", f"time.end={end}",
+           "--set", "output.frame_interval=0.5"]
+    if refinement is not None:
+        cmd += ["--set", "effects.refinement=" + json.dumps(refinement)]
+    for e in extra:
+        cmd += ["--set", e]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode not in (0, 1):  # 1: the watchdog stopped the run (run.json says why)
+        print(f"FAILED {name}: {r.stderr.strip()}", file=sys.stderr)
+    return name, out
+
+
+def layer_pressure(out, t0):
+    """Mean pressure per 1 m layer (0..10 m), averaged over the frames with t >= t0."""
+    sums, frames = np.zeros(int(DEPTH)), 0
+    for path in frame_files(out):
+        f = load_frame(path)
+        if f["time"] < t0 - 1e-9:
+            continue
+        d = f["fields"]
+        fluid = d["kind"] == 0
+        y, p = d["position"][fluid, 1], d["pressure"][fluid]
+        k = np.clip(np.floor(y).astype(int), 0, int(DEPTH) - 1)
+        sums += np.bincount(k, weights=p, minlength=int(DEPTH))[: int(DEPTH)] / np.maximum(
+            np.bincount(k, minlength=int(DEPTH))[: int(DEPTH)], 1)
+        frames += 1
+    return sums / max(frames, 1)
+
+
+def summarize(out, end):
+    with open(os.path.join(out, "run.json")) as f:
+        summary = json.load(f)
+    s = load_series(out)
+    t = s["time"]
+    window = t >= end / 3.0
+    after = np.nonzero(t >= 1.0)[0]
+    return {
+        "status": summary.get("status", "?"),
+        "ended": float(t[-1]) if len(t) else 0.0,
+        "vmax": float(np.max(s["max_speed"])),
+        "vmean": float(np.mean(s["max_speed"][window])) if window.any() else float("nan"),
+        "fluid_first": int(s["fluid"][after[0]]) if len(after) else int(s["fluid"][-1]),
+        "fluid_end": int(s["fluid"][-1]),
+        "removed": int(s["removed"][-1]) if "removed" in s else 0,
+        "layers": layer_pressure(out, end / 3.0),
+    }
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--end", type=float, default=30.0)
+    ap.add_argument("--set", action="append", default=[], dest="extra")
+    ap.add_argument("--skip-runs", action="store_true")
+    ap.add_argument("--only", default="")
+    ap.add_argument("--out", default=os.path.join(ROOT, "results", "still_water"))
+    args = ap.parse_args()
+    jobs = variants()
+    if args.only:
+        keep = set(args.only.split(",")) | {"unrefined"}
+        jobs = [j for j in jobs if j[0] in keep]
+    if not args.skip_runs:
+        with ThreadPoolExecutor(max_workers=args.jobs) as pool:
+            list(pool.map(lambda j: run(j, args.out, args.end, args.extra), jobs))
+    res = {name: summarize(os.path.join(args.out, name), args.end) for name, _ in jobs}
+    base = res["unrefined"]
+    print(f"Still tank, {args.end:g} s, one thread; window t >= {args.end / 3:g} s"
+          + (f"; every run with {' '.join(args.extra)}" if args.extra else "") + "\n")
+    print("| run | status | max |v| (m/s) | mean max |v| in window | / unrefined | layer p err (max, < 9 m) "
+          "| / rho g H | fluid after 1st pass -> end |")
+    print("|---|---|---|---|---|---|---|---|")
+    ok = True
+    for name, _ in jobs:
+        r = res[name]
+        ok &= r["status"] == "completed"
+        rel = np.abs(r["layers"][:9] - base["layers"][:9]) / np.abs(base["layers"][:9])
+        absn = np.abs(r["layers"][:9] - base["layers"][:9]) / (RHO0 * G * DEPTH)
+        status = r["status"] if r["status"] == "completed" else f"{r['status']} at {r['ended']:.2f} s"
+        print(f"| {name} | {status} | {r['vmax']:.3g} | {r['vmean']:.3g} | {r['vmean'] / base['vmean']:.3g} "
+              f"| {100 * rel.max():.2f} % | {100 * absn.max():.2f} % | {r['fluid_first']} -> {r['fluid_end']} |")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
