@@ -40,7 +40,6 @@ struct SolverSettings {
   std::optional<LennardJonesSettings> lennard_jones;
   std::optional<GhostSlip> ghosts = GhostSlip::free_slip;
   GhostPressure ghost_pressure = GhostPressure::hydrostatic;
-  bool pressure_corrected_across_levels = false;  // PressureGradient::corrected_across_levels
   Geometry2 geometry;
   double cfl = 0.2;
   double dt_max = 1.0;  // upper bound on the step (s)

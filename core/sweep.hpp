@@ -27,13 +27,8 @@ struct SweepLimits {
 template <int D, class FluidEffects, class WallEffects>
 class PairSweep {
  public:
-  /// track_levels: tell the effects (PairSums::mixed_levels) whether a fluid or ghost neighbour of another
-  /// smoothing length lies within 2 max(h_i, h_j), also beyond the pair's own support h_i + h_j (as far as the
-  /// candidates reach, h_i + h_max: all of it for the coarsest particles, whose complete neighbourhood of their
-  /// own level has holes where a finer level begins; a finer particle's own-level support ends before them).
-  PairSweep(FluidEffects fluid, WallEffects wall, double c0, Vec<D> gravity, bool track_levels = false)
-      : fluid_(std::move(fluid)), wall_(std::move(wall)), c0_(c0), gravity_(std::move(gravity)),
-        track_levels_(track_levels) {}
+  PairSweep(FluidEffects fluid, WallEffects wall, double c0, Vec<D> gravity)
+      : fluid_(std::move(fluid)), wall_(std::move(wall)), c0_(c0), gravity_(std::move(gravity)) {}
 
   /// Computes a and drho of every fluid particle (others get zero) from the current state.
   SweepLimits operator()(ParticleView<D> s, const CellGrid<D>& grid) const {
@@ -65,10 +60,6 @@ class PairSweep {
               const Vec<D> xij = xi - s.x[j];
               const double r2 = xij.squaredNorm();
               const double support = hi + s.h[j];
-              if (track_levels_ && s.h[j] != hi && s.kind[j] != Kind::wall) {
-                const double reach = std::min(2.0 * std::max(hi, s.h[j]), hi + grid.max_h());
-                if (r2 < reach * reach) acc.mixed_levels = true;
-              }
               if (r2 >= support * support || j == i) continue;
               pr.j = j;
               pr.xij = xij;
@@ -91,7 +82,6 @@ class PairSweep {
               mu_max = std::max(mu_max, std::abs(pr.mu));
             }
           });
-          std::apply([&](const auto&... eff) { (finish(eff, s, i, acc), ...); }, fluid_);
           acc.a += gravity_;
           s.a[i] = acc.a;
           s.drho[i] = acc.drho;
@@ -107,17 +97,10 @@ class PairSweep {
   }
 
  private:
-  /// An effect's closing step for particle i after its neighbour loop, for effects that have one.
-  template <class Effect>
-  static void finish(const Effect& eff, const ParticleView<D>& s, std::size_t i, PairSums<D>& acc) {
-    if constexpr (requires { eff.finish(s, i, acc); }) eff.finish(s, i, acc);
-  }
-
   FluidEffects fluid_;
   WallEffects wall_;
   double c0_;
   Vec<D> gravity_;
-  bool track_levels_ = false;
 };
 
 }  // namespace sph

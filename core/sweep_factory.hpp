@@ -29,8 +29,8 @@ class SweepBase {
 template <class Fluid, class Wall>
 class SweepImpl final : public SweepBase {
  public:
-  SweepImpl(Fluid f, Wall w, double c0, Vec<2> g, std::string name, bool track_levels)
-      : sweep_(std::move(f), std::move(w), c0, std::move(g), track_levels), name_(std::move(name)) {}
+  SweepImpl(Fluid f, Wall w, double c0, Vec<2> g, std::string name)
+      : sweep_(std::move(f), std::move(w), c0, std::move(g)), name_(std::move(name)) {}
   SweepLimits run(ParticleView<2> s, const CellGrid<2>& grid) const override { return sweep_(s, grid); }
   const char* name() const override { return name_.c_str(); }
 
@@ -47,10 +47,9 @@ std::unique_ptr<SweepBase> with_walls(Fluid fluid, const SolverSettings& s, std:
   if (s.lennard_jones) {
     auto wall = std::make_tuple(LennardJonesWall{s.lennard_jones->strength, s.lennard_jones->r0_factor});
     return std::make_unique<SweepImpl<Fluid, decltype(wall)>>(std::move(fluid), std::move(wall), s.eos.c0, g,
-                                                             name + "|lj", s.pressure_corrected_across_levels);
+                                                             name + "|lj");
   }
-  return std::make_unique<SweepImpl<Fluid, std::tuple<>>>(std::move(fluid), std::tuple<>{}, s.eos.c0, g, name,
-                                                          s.pressure_corrected_across_levels);
+  return std::make_unique<SweepImpl<Fluid, std::tuple<>>>(std::move(fluid), std::tuple<>{}, s.eos.c0, g, name);
 }
 
 template <class Fluid>
@@ -76,14 +75,12 @@ std::unique_ptr<SweepBase> with_stress(Fluid fluid, const SolverSettings& s, std
 }  // namespace sweep_detail
 
 inline std::unique_ptr<SweepBase> make_sweep(const SolverSettings& s) {
-  const std::tuple<Continuity, PressureGradient> base{Continuity{}, PressureGradient{s.pressure_corrected_across_levels}};
-  const std::string pressure = s.pressure_corrected_across_levels ? "continuity+pressure_corrected_across_levels"
-                                                                  : "continuity+pressure";
+  const std::tuple<Continuity, PressureGradient> base{};
   if (s.viscosity) {
     const ArtificialViscosity av{s.viscosity->alpha, s.viscosity->beta, s.eos.c0};
-    return sweep_detail::with_stress(std::tuple_cat(base, std::make_tuple(av)), s, pressure + "+viscosity");
+    return sweep_detail::with_stress(std::tuple_cat(base, std::make_tuple(av)), s, "continuity+pressure+viscosity");
   }
-  return sweep_detail::with_stress(base, s, pressure);
+  return sweep_detail::with_stress(base, s, "continuity+pressure");
 }
 
 }  // namespace sph

@@ -13,7 +13,6 @@
 #include <vector>
 
 #include "core/kernel.hpp"
-#include "core/refinement/split_pass.hpp"
 #include "core/scene/scene_builder.hpp"
 #include "core/scene/scene_parser.hpp"
 #include "core/sweep_factory.hpp"
@@ -136,22 +135,10 @@ Reference brute_force(const ParticleStore<2>& s, const SolverSettings& st) {
   ref.a_scale.assign(n, 0.0);
   const Vec<2> g = st.gravity.value_or(Vec<2>::Zero());
   const double c = st.eos.c0;
-  double h_max = 0.0;
-  for (std::size_t j = 0; j < n; ++j) h_max = std::max(h_max, s.h[j]);
   for (std::size_t i = 0; i < n; ++i) {
     if (s.kind[i] != Kind::fluid) continue;
     Vec<2> ai = g;
     double scale = g.norm(), drho = 0.0, drho_scale = 0.0, mu_max = 0.0;
-    // The pressure term where levels meet (PressureGradient::corrected_across_levels): particle i is at a level
-    // jump when a fluid or ghost particle of another h lies within 2 max(h_i, h_j), as far as h_i + h_max.
-    bool mixed = false;
-    Vec<2> p_sym = Vec<2>::Zero(), p_diff = Vec<2>::Zero();
-    Eigen::Matrix2d moment = Eigen::Matrix2d::Zero();
-    for (std::size_t j = 0; st.pressure_corrected_across_levels && j < n; ++j) {
-      if (j == i || s.kind[j] == Kind::wall || s.h[j] == s.h[i]) continue;
-      const double reach = std::min(2.0 * std::max(s.h[i], s.h[j]), s.h[i] + h_max);
-      mixed = mixed || (s.x[i] - s.x[j]).norm() < reach;
-    }
     for (std::size_t j = 0; j < n; ++j) {
       if (j == i) continue;
       const Vec<2> xij = s.x[i] - s.x[j];
@@ -196,20 +183,6 @@ Reference brute_force(const ParticleStore<2>& s, const SolverSettings& st) {
       const Vec<2> f = -s.m[j] * bracket * gradW;
       ai += f;
       scale += f.norm();
-      if (st.pressure_corrected_across_levels) {
-        const double pressure_bracket = s.p[i] / (s.rho[i] * s.rho[i]) + s.p[j] / (s.rho[j] * s.rho[j]);
-        p_sym += s.m[j] * pressure_bracket * gradW;
-        const double vj = s.m[j] / s.rho[j];
-        p_diff += vj * (s.p[j] - s.p[i]) * gradW;
-        moment += vj * gradW * (s.x[j] - s.x[i]).transpose();
-      }
-    }
-    if (st.pressure_corrected_across_levels && mixed) {
-      // Swap the symmetric pressure term for grad p / rho_i with grad p = M^-1 sum V_j (p_j - p_i) grad W
-      // (the plain difference sum where det M < 1/4).
-      const Vec<2> grad_p = moment.determinant() >= 0.25 ? Vec<2>(moment.inverse() * p_diff) : p_diff;
-      ai += p_sym - grad_p / s.rho[i];
-      scale += p_sym.norm() + grad_p.norm() / s.rho[i];
     }
     ref.a[i] = ai;
     ref.a_scale[i] = scale;
@@ -306,79 +279,6 @@ TEST(Sweep, EqualsBruteForceWithoutViscosity) {
   const SolverSettings st = twin_settings(false, false);
   ParticleStore<2> s = twin_cloud(st, 7u);
   expect_matches_brute_force(s, st, "no viscosity");
-}
-
-// The corrected pressure term where levels meet: mixed-level cloud (levels 0 and 1 side by side), with and
-// without viscosity; the comparison must see the correction (it moves many accelerations).
-TEST(Sweep, EqualsBruteForceWithThePressureCorrectedAcrossLevels) {
-  for (bool viscosity : {false, true}) {
-    SolverSettings st = twin_settings(viscosity, false);
-    st.pressure_corrected_across_levels = true;
-    ParticleStore<2> s = twin_cloud(st, 12u);
-    expect_matches_brute_force(s, st, viscosity ? "corrected pressure, viscosity" : "corrected pressure");
-    SolverSettings plain = st;
-    plain.pressure_corrected_across_levels = false;
-    EXPECT_GT(changed_accelerations(brute_force(s, st), brute_force(s, plain)), 100u);
-  }
-}
-
-// Still water across a level jump: a hydrostatic lattice (p = rho0 g (H - y), linear) with a block split into
-// four daughters per particle, no walls. Away from the lattice's edges, the symmetric form pushes the particles
-// at the jump harder than gravity pulls (its zeroth-order error 2 p/rho sum V_j grad W); the corrected form is
-// exact for a linear pressure, so there a_i = g (rho0 / rho_i - 1) up to rounding, and elsewhere it is the
-// symmetric form.
-TEST(Sweep, CorrectedPressureHoldsAHydrostaticLatticeAcrossALevelJump) {
-  SolverSettings st;
-  st.eos.rho0 = 1000.0;
-  st.eos.c0 = 50.0;
-  st.gravity = Vec<2>(0.0, -9.81);
-  st.ghosts.reset();
-  st.viscosity.reset();
-  const double g = 9.81, H = 10.0, d = 0.5;
-  ParticleStore<2> s;
-  for (double y = d / 2; y < H; y += d) {
-    for (double x = d / 2; x < 20.0; x += d) {
-      ParticleInit p;
-      p.x = Vec<2>(x, y);
-      p.rho = st.eos.density(st.eos.rho0 * g * (H - y));
-      p.m = st.eos.rho0 * d * d;
-      p.h = 1.2 * d;
-      p.d = d;
-      add_particle(s, p, st.eos);
-    }
-  }
-  std::vector<std::uint8_t> block(s.size(), 0);
-  for (std::size_t i = 0; i < s.size(); ++i) block[i] = s.x[i][0] > 8 && s.x[i][0] < 12 && s.x[i][1] > 3 && s.x[i][1] < 7;
-  sph::refine::split_marked(s, block, sph::refine::Pattern::aap, 1.0, 1, {});
-  for (std::size_t i = 0; i < s.size(); ++i) s.p[i] = st.eos.rho0 * g * (H - s.x[i][1]);  // daughters too: linear p
-  ParticleStore<2> sym = s, cor = s;
-  run_sweep(sym, st);
-  st.pressure_corrected_across_levels = true;
-  run_sweep(cor, st);
-  const double h_max = 1.2 * d;
-  double sym_jump = 0.0;
-  std::size_t band = 0, interior = 0;
-  for (std::size_t i = 0; i < cor.size(); ++i) {
-    const Vec<2> x = cor.x[i];
-    if (x[0] < 2 * 2 * h_max || x[0] > 20 - 2 * 2 * h_max || x[1] < 2 * 2 * h_max || x[1] > H - 2 * 2 * h_max) continue;
-    ++interior;
-    bool mixed = false;
-    for (std::size_t j = 0; j < cor.size(); ++j)
-      mixed = mixed || (cor.h[j] != cor.h[i] && (cor.x[j] - x).norm() < std::min(2 * std::max(cor.h[i], cor.h[j]), cor.h[i] + h_max));
-    const std::size_t k = std::find(sym.id.values().begin(), sym.id.values().end(), cor.id[i]) - sym.id.values().begin();
-    if (mixed) {
-      ++band;
-      sym_jump = std::max(sym_jump, sym.a[k].norm());
-      // Exact for linear p: what is left is gravity against rho0 / rho_i, and rounding (sums of ~50 terms).
-      const Vec<2> exact(0.0, g * (st.eos.rho0 / cor.rho[i] - 1.0));
-      EXPECT_LE((cor.a[i] - exact).norm(), 1e-9 * g) << "band particle at " << x.transpose();
-    } else {
-      EXPECT_LE((cor.a[i] - sym.a[k]).norm(), 1e-12 * (st.eos.rho0 * g * H / st.eos.rho0 / d)) << x.transpose();
-    }
-  }
-  EXPECT_GT(band, 100u);
-  EXPECT_GT(interior, band);
-  EXPECT_GT(sym_jump, g) << "the symmetric form's error at the jump exceeds gravity (the defect corrected here)";
 }
 
 TEST(Sweep, EqualsBruteForceWithViscosity) {

@@ -26,12 +26,6 @@ template <int D>
 struct PairSums {
   double drho = 0.0;
   Vec<D> a = Vec<D>::Zero();
-  // The pressure term across level jumps (PressureGradient::corrected_across_levels): both forms are summed,
-  // and the sweep says whether a neighbour of another level is within 2 max(h_i, h_j).
-  bool mixed_levels = false;
-  Vec<D> pressure_symmetric = Vec<D>::Zero();
-  Vec<D> pressure_difference = Vec<D>::Zero();
-  Eigen::Matrix<double, D, D> moment = Eigen::Matrix<double, D, D>::Zero();
 };
 
 }  // namespace sph

@@ -127,7 +127,6 @@ struct Effects {
   std::optional<LennardJonesWall> lennard_jones_wall;
   std::optional<Slip> ghost_walls;
   bool ghost_pressure_mirrored = false;  // ghost_pressure: "hydrostatic" (default) or "mirrored"
-  bool pressure_corrected_across_levels = false;  // pressure_across_levels: "symmetric" (default) or "corrected"
   std::optional<Refinement> refinement;
   std::optional<StaticRefinement> static_refinement;
   bool operator==(const Effects&) const = default;

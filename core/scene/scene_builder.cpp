@@ -52,7 +52,6 @@ SolverSettings solver_settings(const Scene& scene) {
   s.ghosts.reset();
   if (e.ghost_walls) s.ghosts = *e.ghost_walls == Slip::free_slip ? GhostSlip::free_slip : GhostSlip::no_slip;
   s.ghost_pressure = e.ghost_pressure_mirrored ? GhostPressure::mirrored : GhostPressure::hydrostatic;
-  s.pressure_corrected_across_levels = e.pressure_corrected_across_levels;
   s.geometry.container = box(scene.container.box);
   s.geometry.open_top = scene.container.open_top;
   s.geometry.outflow = scene.container.outflow;

@@ -254,7 +254,7 @@ StaticRefinement parse_static_refinement(const Json& j, const std::string& path)
 
 Effects parse_effects(const Json& j, const std::string& path) {
   ObjectReader r(j, path,
-                 {"gravity", "artificial_viscosity", "artificial_stress", "density_diffusion", "lennard_jones_wall", "ghost_walls", "ghost_pressure", "pressure_across_levels", "refinement",
+                 {"gravity", "artificial_viscosity", "artificial_stress", "density_diffusion", "lennard_jones_wall", "ghost_walls", "ghost_pressure", "refinement",
                   "static_refinement"});
   Effects e;
   if (r.has("gravity")) e.gravity = r.vec2("gravity");
@@ -283,8 +283,6 @@ Effects parse_effects(const Json& j, const std::string& path) {
   if (r.has("ghost_walls")) {
     e.ghost_walls = r.choice<Slip>("ghost_walls", {{"free-slip", Slip::free_slip}, {"no-slip", Slip::no_slip}}, std::nullopt);
   }
-  e.pressure_corrected_across_levels =
-      r.choice<bool>("pressure_across_levels", {{"symmetric", false}, {"corrected", true}}, false);
   if (r.has("ghost_pressure")) {
     e.ghost_pressure_mirrored = r.choice<bool>("ghost_pressure", {{"hydrostatic", false}, {"mirrored", true}}, false);
   }

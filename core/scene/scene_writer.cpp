@@ -67,7 +67,6 @@ Json scene_to_json(const Scene& s) {
   }
   if (fx.ghost_walls) e["ghost_walls"] = to_string(*fx.ghost_walls);
   e["ghost_pressure"] = fx.ghost_pressure_mirrored ? "mirrored" : "hydrostatic";
-  e["pressure_across_levels"] = fx.pressure_corrected_across_levels ? "corrected" : "symmetric";
   if (fx.refinement) {
     const Refinement& r = *fx.refinement;
     Json o;
