@@ -142,6 +142,36 @@ TEST(Runner, ResumedRunIsBitwiseIdenticalToTheUninterruptedOne) {
   EXPECT_FALSE(has_temporary_files(c_dir));
 }
 
+// The same with coarsening: families split in a zone at the toe of the column and merge as the toe runs out
+// of it; the merge state (level_time, origin) travels in the checkpoint like every field.
+TEST(Runner, ResumedRunWithCoarseningIsBitwiseIdenticalToTheUninterruptedOne) {
+  TempFolder tmp;
+  scene::Scene s = tiny_scene();
+  scene::Refinement r;
+  r.criterion = scene::Criterion::zone;
+  r.zone = scene::Rect{Vec<2>(0.7, 0.0), Vec<2>(1.0, 0.4)};  // the toe of the column, which runs out of it
+  r.check_interval = 10;
+  r.coarsening = scene::Coarsening{};
+  r.coarsening->hold_time = 0.005;
+  s.effects.refinement = r;
+  s.time.end = 0.15;
+  const fs::path a_dir = tmp.path() / "a", c_dir = tmp.path() / "c";
+  scene::Runner a(s, scene::RunOptions{a_dir, std::nullopt, 0.05});
+  a.start();
+  while (!fs::exists(io::RunFiles{a_dir}.checkpoint())) a.advance();
+  fs::copy(a_dir, c_dir, fs::copy_options::recursive);
+  a.run();
+  std::size_t merged = 0;
+  const auto& st = a.simulation().store();
+  for (std::size_t i = 0; i < st.size(); ++i) merged += st.origin[i] == Origin::merge || st.origin[i] == Origin::fresh_merge;
+  EXPECT_GT(merged, 0u) << "no family merged: the test would not see the merge's state";
+  scene::Runner c(s, scene::RunOptions{c_dir, c_dir / "checkpoint.h5", 0.05});
+  c.run();
+  EXPECT_EQ(c.simulation().step_count(), a.simulation().step_count());
+  expect_bitwise_equal(c.simulation().store(), a.simulation().store());
+  EXPECT_EQ(lines(c_dir / "series.csv"), lines(a_dir / "series.csv"));
+}
+
 // A finished run extended with a later time.end (--resume --set time.end=...) is the run that went to the
 // later end without stopping, bitwise, at 1 and 2 threads. The first run's last step is shortened to land on
 // its end (0.043 s falls between steps), which the longer run never does.
