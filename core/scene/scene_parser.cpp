@@ -212,7 +212,7 @@ Coarsening parse_coarsening(const Json& j, const std::string& path, const Refine
   Coarsening c;
   if (f.criterion == Criterion::velocity) c.v_threshold = r.number("v_threshold", 0.5 * f.v_threshold);
   if (f.criterion == Criterion::few_neighbours) c.min_neighbours = r.integer("min_neighbours", 2 * f.min_neighbours);
-  c.hold_time = r.number("hold_time", 0.5);
+  c.hold_time = r.number("hold_time", Coarsening{}.hold_time);
   return c;
 }
 

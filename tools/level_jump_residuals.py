@@ -1,0 +1,100 @@
+#!/usr/bin/python3
+"""The static force imbalance of a hydrostatic lattice across a 2:1 level jump, for several pressure-term
+forms (docs/METHOD.md, "Still water across a level jump").
+
+    /usr/bin/python3 tools/level_jump_residuals.py
+
+A 40 x 30 lattice (spacing d = 1 m, h = 1.2 d, rho = 1, p/rho = g (30 - y)) whose block [15,25] x [10,20] is
+split by AAP (daughters at +-d/4, h/2 unless a ratio is given). For each form it prints the largest
+|a_i - g| over the particles at least 4 m from the lattice's edges, coarse and fine apart (m/s^2). The
+kernel is the cubic spline of core/kernel.hpp, written again here in numpy because this evaluates the sums
+outside the solver (every pair against every other, no cell grid).
+"""
+import numpy as np
+
+SIGMA = 10.0 / (7.0 * np.pi)
+D, HF, G, TOP = 1.0, 1.2, 9.81, 30.0
+ZONE = (15, 10, 25, 20)
+
+
+def dwdr(r, h):
+    q = r / h
+    c = SIGMA / h ** 3
+    with np.errstate(over="ignore", invalid="ignore"):
+        return np.where(q < 1, c * (-3 * q + 2.25 * q * q), np.where(q < 2, c * (-0.75 * (2 - q) ** 2), 0.0))
+
+
+def lattice(zone, ratio=0.5):
+    X, H, M, L = [], [], [], []
+    for i in range(40):
+        for j in range(30):
+            x = np.array([(i + 0.5) * D, (j + 0.5) * D])
+            if zone[0] <= x[0] <= zone[2] and zone[1] <= x[1] <= zone[3]:
+                for o in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+                    X.append(x + 0.25 * D * np.array(o)); H.append(HF * D * ratio); M.append(D * D / 4); L.append(1)
+            else:
+                X.append(x); H.append(HF * D); M.append(D * D); L.append(0)
+    return np.array(X), np.array(H), np.array(M), np.array(L)
+
+
+def smooth_h(X, H, slope):
+    """A transition band: h_i = max(h_i, max_j (h_j - slope r_ij))."""
+    return np.array([max(H[i], np.max(H - slope * np.hypot(*(X - X[i]).T))) for i in range(len(X))])
+
+
+def residuals(form, ratio=0.5, slope=None, zone=ZONE):
+    X, H, M, L = lattice(zone, ratio)
+    if slope is not None:
+        H = smooth_h(X, H, slope)
+    p = G * (TOP - X[:, 1])
+    sel = np.where((X[:, 0] > 6) & (X[:, 0] < 34) & (X[:, 1] > 4) & (X[:, 1] < 26))[0]
+    res = np.zeros(len(sel))
+    for k, i in enumerate(sel):
+        xij = X[i] - X
+        r = np.hypot(xij[:, 0], xij[:, 1])
+        r[i] = np.inf
+        hi, hj = H[i], H
+        mean = dwdr(r, 0.5 * (hi + hj)) / r
+        mixed = np.any((H != hi) & (r < 2 * np.maximum(hi, H)))
+        if form == "avggrad":
+            fi = fj = 0.5 * (dwdr(r, hi) + dwdr(r, hj)) / r
+        elif form == "max":
+            fi = fj = dwdr(r, np.maximum(hi, hj)) / r
+        elif form == "lagrangian":
+            fi, fj = dwdr(r, hi) / r, dwdr(r, hj) / r
+        else:
+            fi = fj = mean
+        gw = M[:, None] * mean[:, None] * xij  # V_j grad W (rho = 1)
+        if form == "difference" or (form == "band" and mixed):
+            a = -((p - p[i])[:, None] * gw).sum(0)
+        elif form == "mixed_pairs":
+            a = -((np.where(H != hi, p - p[i], p + p[i]))[:, None] * gw).sum(0)
+        elif form == "band_corrected" and mixed:
+            moment = np.einsum("ja,jb->ab", gw, -xij)
+            a = -np.linalg.solve(moment, ((p - p[i])[:, None] * gw).sum(0))
+        else:
+            a = -(M[:, None] * (p[i] * fi + p * fj)[:, None] * xij).sum(0)
+        res[k] = np.hypot(*(a + np.array([0.0, -G])))
+    lev = L[sel]
+    return res[lev == 0].max(), (res[lev == 1].max() if (lev == 1).any() else float("nan"))
+
+
+def main():
+    rows = [("uniform lattice, no jump", dict(form="symmetric", zone=(-9, -9, -8, -8))),
+            ("paper: h_ij mean, daughters h/2", dict(form="symmetric"))]
+    rows += [(f"daughters' h ratio {q}", dict(form="symmetric", ratio=q)) for q in (0.6, 0.7, 0.8)]
+    rows += [("averaged gradient", dict(form="avggrad")), ("h_ij = max", dict(form="max")),
+             ("variable-h (Lagrangian)", dict(form="lagrangian")),
+             ("transition band, slope 0.1", dict(form="symmetric", slope=0.1)),
+             ("difference form, every pair", dict(form="difference")),
+             ("difference form, mixed pairs only", dict(form="mixed_pairs")),
+             ("difference form, band", dict(form="band")),
+             ("difference form, band, gradient-corrected", dict(form="band_corrected"))]
+    print("| pair form | coarse at the jump | fine at the jump |\n|---|---|---|")
+    for name, kw in rows:
+        c, f = residuals(**kw)
+        print(f"| {name} | {c:.2g} | {f:.3g} |")
+
+
+if __name__ == "__main__":
+    main()
