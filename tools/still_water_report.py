@@ -17,6 +17,7 @@ pass and at the end. Figures:
     layers below 9 m (the top layer's pressure is near zero, so a relative error means nothing there), and
     the same normalised by rho g H at the floor;
   - creep: the fluid count at the first output after the first pass (t >= 1 s) and at the end.
+The environment variable SPH_APP names another sphrefine binary (to compare a build with a candidate change).
 Exit status 0 when every run completed; 1 when one failed.
 """
 import argparse
@@ -29,7 +30,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-APP = os.path.join(ROOT, "build", "release", "app", "sphrefine")
+APP = os.environ.get("SPH_APP", os.path.join(ROOT, "build", "release", "app", "sphrefine"))
 SCENE = os.path.join(ROOT, "cases", "still_tank.json")
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 from read_output import frame_files, load_frame, load_series  # noqa: E402
