@@ -33,6 +33,8 @@ struct ParticleView {
   double* rhoh = nullptr;
   double* level_time = nullptr;
   Origin* origin = nullptr;
+  Vec<D>* kick = nullptr;
+  double* kick_rho = nullptr;
 };
 
 template <int D>
@@ -62,6 +64,10 @@ class ParticleStore {
   // Coarsening holds a family at its level for a minimum time (core/refinement/merge_pass.hpp).
   Field<double> level_time{"level_time", "s"};
   Field<Origin> origin{"origin", "1"};  // core/types.hpp: a fresh merge is not split at the next check
+  // The pair sweep's weighted sums (core/sweep.hpp): the integrator kicks v and rho by dt0 times them. Equal to
+  // a and drho with one global step; with time bins they hold only the pairs due at the current substep.
+  Field<VecD> kick{"kick_rate", "m/s^2"};
+  Field<double> kick_rho{"kick_density_rate", "kg/m^3/s"};
 
   /// The registry: every field as a pointer to member. Adding a field above and here is all it takes for
   /// every operation (gather, compaction, expansion, copies, output, checkpoints) to carry it.
@@ -70,7 +76,7 @@ class ParticleStore {
                            &ParticleStore::m, &ParticleStore::h, &ParticleStore::d, &ParticleStore::level,
                            &ParticleStore::kind, &ParticleStore::id, &ParticleStore::drho, &ParticleStore::a,
                            &ParticleStore::vh, &ParticleStore::rhoh, &ParticleStore::level_time,
-                           &ParticleStore::origin);
+                           &ParticleStore::origin, &ParticleStore::kick, &ParticleStore::kick_rho);
   }
 
   /// Visits every field. f is called with each Field<T>&.
@@ -171,7 +177,7 @@ class ParticleStore {
   ParticleView<D> view() {
     return {size(), x.data(), v.data(), rho.data(), p.data(), m.data(), h.data(), d.data(),
             level.data(), kind.data(), id.data(), drho.data(), a.data(), vh.data(), rhoh.data(), level_time.data(),
-            origin.data()};
+            origin.data(), kick.data(), kick_rho.data()};
   }
 
   /// Bytes held by every field (data and scratch), for memory reports.
@@ -183,7 +189,7 @@ class ParticleStore {
 
   /// Bytes one particle occupies across all fields.
   static constexpr std::size_t bytes_per_particle() {
-    return 4 * sizeof(VecD) + 8 * sizeof(double) + sizeof(std::int32_t) + sizeof(Kind) + sizeof(ParticleId) +
+    return 5 * sizeof(VecD) + 9 * sizeof(double) + sizeof(std::int32_t) + sizeof(Kind) + sizeof(ParticleId) +
            sizeof(Origin);
   }
 

@@ -7,10 +7,12 @@
 
 #include "core/neighbour_cells.hpp"
 #include "parallel/parallel_for.hpp"
+#include "parallel/scan.hpp"
 
 namespace sph {
 
-Simulation::Simulation(SolverSettings settings) : settings_(std::move(settings)) {
+Simulation::Simulation(SolverSettings settings)
+    : settings_(std::move(settings)), integrator_(settings_.stepping, settings_.eos) {
   if (settings_.ghosts) {
     ghosts_.emplace(settings_.geometry.walls(), *settings_.ghosts, settings_.ghost_pressure,
                     settings_.gravity.value_or(Vec<2>::Zero()), settings_.eos);
@@ -92,7 +94,7 @@ void Simulation::refresh() {
     if (s.kind[i] == Kind::fluid) s.p[i] = eos.pressure(s.rho[i]);
   });
   prepare_neighbours();
-  limits_ = sweep_->run(store_.view(), grid_);
+  limits_ = sweep_->run(store_.view(), grid_, integrator_.activity(1, 0));
   dt_ = next_dt();
 }
 
@@ -101,73 +103,120 @@ double Simulation::next_dt() const {
   return std::min(dt, settings_.dt_max);
 }
 
+void Simulation::count_work(int finest, const SweepLimits& lim) {
+  // Particles per level (the levels do not change within a step), then how many times each was due: bin b is
+  // due every 2^(finest - b) of the 2^finest substeps, i.e. 2^b times a step.
+  std::array<std::uint64_t, Work::kLevels> per_level{};
+  const auto s = store_.view();
+  for (std::size_t i = 0; i < s.n; ++i)
+    if (s.kind[i] == Kind::fluid) ++per_level[static_cast<std::size_t>(std::min(s.level[i], Work::kLevels - 1))];
+  for (int l = 0; l < Work::kLevels; ++l)
+    work_.evaluations[static_cast<std::size_t>(l)] +=
+        per_level[static_cast<std::size_t>(l)] << integrator_.bin(l);
+  work_.pairs += lim.pairs;
+  work_.candidates += lim.candidates;
+  work_.substeps += 1u << finest;
+}
+
+void Simulation::store_restored() {
+  const auto s = store_.view();
+  int finest = 0;
+  for (std::size_t i = 0; i < s.n; ++i)
+    if (s.kind[i] == Kind::fluid) finest = std::max(finest, integrator_.bin(s.level[i]));
+  limits_.finest_bin = finest;
+}
+
+Activity Simulation::activity(int k, int finest) {
+  Activity act = integrator_.activity(k, finest);
+  if (act.active_bin == 0) return act;  // every particle is due
+  const auto s = store_.view();
+  due_prefix_.resize(s.n + 1);
+  par::parallel_for(s.n, [&](std::size_t i) {
+    due_prefix_[i] = s.kind[i] != Kind::wall && act.bin(s.level[i]) >= act.active_bin ? 1u : 0u;
+  });
+  due_prefix_[s.n] = par::exclusive_scan(due_prefix_.data(), due_prefix_.data(), s.n);
+  act.due_prefix = due_prefix_.data();
+  return act;
+}
+
 StepInfo Simulation::step(double dt_cap) {
   const double dt = std::min(dt_, dt_cap);
   const bool watch = settings_.watchdog.enabled;
-  const double half = 0.5 * dt;
-  const TaitEquationOfState eos = settings_.eos;
+  const Integrator& integ = integrator_;
+  // The finest bin of the step: the levels cannot change within it, and limits_ comes from an evaluation of
+  // every particle (the end of the last step, or refresh()).
+  const int finest = limits_.finest_bin;
+  const int substeps = 1 << finest;
+  const double tau = std::ldexp(dt, -finest);
   std::string step_error;
-  // One parallel region for the rollback copy, the kick and drift, and the first pass of the neighbour
-  // preparation (each particle's output count and the smoothing-length range): all per particle.
   if (watch) {
     last_good_.prepare_copy_of(store_);  // reuses capacity: no allocation once the sizes are stable
     last_good_limits_ = limits_;
     last_good_removed_ = removed_;
   }
-  SmoothingRange hr;
-  {
-    auto s = store_.view();
-    expand_offsets_.resize(s.n + 1);
-    hr = par::reduce(
-        s.n, SmoothingRange{},
-        [&](std::size_t i) {
-          if (watch) last_good_.copy_particle(store_, i);
-          if (s.kind[i] == Kind::fluid) {
-            s.vh[i] = s.v[i] + half * s.a[i];
-            s.rhoh[i] = s.rho[i] + half * s.drho[i];
-            s.x[i] += dt * s.vh[i];
-            s.v[i] = s.vh[i] + half * s.a[i];
-            s.rho[i] = s.rhoh[i] + half * s.drho[i];
-            s.p[i] = eos.pressure(s.rho[i]);
-          }
-          expand_offsets_[i] = output_count(s, i);
-          return SmoothingRange::of(s.kind[i], s.h[i]);
-        },
-        [](const SmoothingRange& a, const SmoothingRange& b) { return a.merged(b); });
-  }
-  // Fluid that left through an open top (container.outflow = "remove") goes now, before the neighbour search
-  // and the watchdog. A removal renumbers the particles, so the counts and range of the loop above are redone.
-  bool renumbered = false;
-  if (settings_.geometry.outflow == Outflow::remove) {
-    const RemovedFluid out = remove_outflow(store_, settings_.geometry);
-    removed_.add(out);
-    renumbered = out.particles > 0;
-  }
-  // The drift can already have produced a non-finite position, which the grid refuses: with the watchdog on,
-  // that is reported (and undone) like any other failure of the step, naming the particle.
-  try {
-    if (renumbered) {
-      prepare_neighbours();
-    } else {
-      build_neighbours(hr);
+  SweepLimits step_limits;
+  for (int k = 1; k <= substeps && step_error.empty(); ++k) {
+    // One parallel region for the rollback copy and the opening kick (first substep) or the previous
+    // substep's kick, the drift and prediction, and the first pass of the neighbour preparation (each
+    // particle's output count and the smoothing-length range): all per particle.
+    SmoothingRange hr;
+    {
+      auto s = store_.view();
+      expand_offsets_.resize(s.n + 1);
+      hr = par::reduce(
+          s.n, SmoothingRange{},
+          [&](std::size_t i) {
+            if (k == 1 && watch) last_good_.copy_particle(store_, i);
+            if (s.kind[i] == Kind::fluid) {
+              if (k == 1) {
+                integ.open(s, i, dt);
+              } else {
+                integ.kick(s, i, dt, false);
+              }
+              integ.drift(s, i, tau, k, finest);
+            }
+            expand_offsets_[i] = output_count(s, i);
+            return SmoothingRange::of(s.kind[i], s.h[i]);
+          },
+          [](const SmoothingRange& a, const SmoothingRange& b) { return a.merged(b); });
     }
-    limits_ = sweep_->run(store_.view(), grid_);
-  } catch (const std::exception& e) {
-    if (!watch) throw;
-    step_error = e.what();
+    // Fluid that left through an open top (container.outflow = "remove") goes now, before the neighbour search
+    // and the watchdog. A removal renumbers the particles, so the counts and range of the loop above are redone.
+    bool renumbered = false;
+    if (settings_.geometry.outflow == Outflow::remove) {
+      const RemovedFluid out = remove_outflow(store_, settings_.geometry);
+      removed_.add(out);
+      renumbered = out.particles > 0;
+    }
+    // The drift can already have produced a non-finite position, which the grid refuses: with the watchdog on,
+    // that is reported (and undone) like any other failure of the step, naming the particle.
+    try {
+      if (renumbered) {
+        prepare_neighbours();
+      } else {
+        build_neighbours(hr);
+      }
+      const SweepLimits lim = sweep_->run(store_.view(), grid_, activity(k, finest));
+      step_limits = SweepLimits{std::min(step_limits.dt_force, lim.dt_force),
+                                std::min(step_limits.dt_cfl, lim.dt_cfl), step_limits.pairs + lim.pairs,
+                                lim.finest_bin,  // the last evaluation covers every bin
+                                step_limits.candidates + lim.candidates};
+    } catch (const std::exception& e) {
+      if (!watch) throw;
+      step_error = e.what();
+    }
   }
   if (step_error.empty()) {
     auto s = store_.view();
     par::parallel_for(s.n, [&](std::size_t i) {
-      if (s.kind[i] != Kind::fluid) return;
-      s.v[i] = s.vh[i] + half * s.a[i];
-      s.rho[i] = s.rhoh[i] + half * s.drho[i];
-      s.p[i] = eos.pressure(s.rho[i]);
+      if (s.kind[i] == Kind::fluid) integ.kick(s, i, dt, true);
     });
+    limits_ = step_limits;
+    count_work(finest, step_limits);
   }
   if (watch) {
     FailureReport report;
-    if (find_failure(store_, settings_.geometry, eos.rho0, settings_.watchdog, report) || !step_error.empty() ||
+    if (find_failure(store_, settings_.geometry, settings_.eos.rho0, settings_.watchdog, report) || !step_error.empty() ||
         !(std::isfinite(dt) && dt > 0.0)) {
       if (report.quantity.empty() && !step_error.empty()) {
         report.quantity = "the step could not be completed (" + step_error + ")";
@@ -191,8 +240,10 @@ StepInfo Simulation::step(double dt_cap) {
   }
   time_ += dt;
   ++step_;
+  fine_steps_ += static_cast<std::uint64_t>(substeps);
+  last_substeps_ = substeps;
   dt_ = next_dt();
-  return {dt, limits_};
+  return {dt, limits_, substeps};
 }
 
 void Simulation::run_stages() {

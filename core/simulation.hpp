@@ -3,17 +3,17 @@
 //   kick + drift -> ghosts -> cell grid (reorders the store) -> pair sweep -> kick, variable dt;
 //   between steps, the run-time stages (refinement, probes, output) get one call each.
 //
-// Time integration (PHYSICS.md decision): kick-drift-kick with one force evaluation per step.
-//   v_h = v_n + dt/2 a_n,  rho_h = rho_n + dt/2 drho_n,  x_{n+1} = x_n + dt v_h,
-//   forces at x_{n+1} with the predicted v = v_h + dt/2 a_n and rho = rho_h + dt/2 drho_n,
-//   v_{n+1} = v_h + dt/2 a_{n+1},  rho_{n+1} = rho_h + dt/2 drho_{n+1}.
-// With central pair forces this conserves linear and angular momentum to rounding.
+// Time integration is core/integrator.hpp: kick-drift-kick, with one global step (time.stepping = "global",
+// the default) or power-of-two steps per refinement level ("per_level"). A step is dt0 for the coarsest bin, in
+// 2^B substeps; the driver runs the loops and the force evaluations the integrator asks for.
 //
-// Parallel regions per step (each a fork and a join, and on busy cores each can cost a scheduler time slice):
-// 1. the watchdog's copy, kick and drift, output counts and h range (one loop); 2. the scan of the counts;
-// 3. the expansion with its bounding box; 4. the cell sort (one region, its phases separated by barriers);
-// 5. the gather of every field through the composed map; 6. the ghosts' values; 7. the pair sweep; 8. the
-// closing kick; 9. the watchdog's scan. There were 19.
+// Parallel regions per substep (each a fork and a join, and on busy cores each can cost a scheduler time
+// slice): 1. the watchdog's copy (first substep), the kick of the previous substep, drift and prediction,
+// output counts and h range (one loop); 2. the scan of the counts; 3. the expansion with its bounding box; 4. the
+// cell sort (one region, its phases separated by barriers); 5. the gather of every field through the composed
+// map; 6. the ghosts' values; 7. the pair sweep. Then per step: 8. the closing kick; 9. the watchdog's scan.
+// With one global step that is 9 regions per step (there were 19).
+#include <array>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -22,6 +22,7 @@
 #include "core/boundary/outflow.hpp"
 #include "core/cell_grid.hpp"
 #include "core/diagnostics.hpp"
+#include "core/integrator.hpp"
 #include "core/neighbour_cells.hpp"
 #include "core/particle_store.hpp"
 #include "core/solver_settings.hpp"
@@ -41,9 +42,19 @@ class Stage {
   virtual bool after_step(Simulation& sim) = 0;
 };
 
+/// The work of the steps taken so far (this process; not part of the state): what accuracy costs, counted.
+struct Work {
+  static constexpr int kLevels = 16;                 // levels beyond share the last entry
+  std::array<std::uint64_t, kLevels> evaluations{};  // particle force evaluations (the particle due), per level
+  std::uint64_t pairs = 0;                           // pair interactions evaluated (each side of a pair counts)
+  std::uint64_t candidates = 0;                      // neighbour candidates checked
+  std::uint64_t substeps = 0;                        // force evaluations of the whole set (sweeps)
+};
+
 struct StepInfo {
   double dt = 0.0;
-  SweepLimits limits;
+  SweepLimits limits;  // over the step's evaluations: smallest limits, pairs summed, finest bin
+  int substeps = 1;    // 2^B
 };
 
 class Simulation {
@@ -55,15 +66,29 @@ class Simulation {
   const ParticleStore<2>& store() const { return store_; }
   const CellGrid<2>& grid() const { return grid_; }
   const GhostBuilder* ghosts() const { return ghosts_ ? &*ghosts_ : nullptr; }
+  const Integrator& integrator() const { return integrator_; }
+  const Work& work() const { return work_; }
 
   double time() const { return time_; }
   std::uint64_t step_count() const { return step_; }
   double dt() const { return dt_; }
+  /// Sets the clock; the finest bin's step count becomes `step` (as with one global step: a resumed per-level
+  /// run sets it with set_fine_step_count after).
   void set_clock(double time, std::uint64_t step, double dt) {
     time_ = time;
     step_ = step;
+    fine_steps_ = step;
     dt_ = dt;
   }
+  /// Steps of the finest bin taken so far (the sweeps: equal to step_count() with one global step); part of the
+  /// state (checkpoints). Refinement checks count these, so check_interval means the same with either stepping.
+  std::uint64_t fine_step_count() const { return fine_steps_; }
+  /// Substeps of the last step (1 with one global step).
+  int last_substeps() const { return last_substeps_; }
+  void set_fine_step_count(std::uint64_t n) { fine_steps_ = n; }
+  /// After the store was replaced without an evaluation (a checkpoint read: the stored rates are the ones the
+  /// next step opens with), re-derives what the step takes from the last evaluation: the finest time bin.
+  void store_restored();
 
   /// Fluid removed so far through the open top (geometry.outflow = remove); part of the state (checkpoints).
   const RemovedFluid& removed() const { return removed_; }
@@ -100,6 +125,10 @@ class Simulation {
 
  private:
   double next_dt() const;
+  /// The activity of substep k, with its due_prefix filled when only some bins are due.
+  Activity activity(int k, int finest);
+  /// Adds a finished step's work (finest bin, summed limits of its sweeps) to work_.
+  void count_work(int finest, const SweepLimits& lim);
   /// How many entries particle i has in the expanded set: ghosts 0, walls 1, fluid 1 + its images.
   std::uint32_t output_count(const ParticleView<2>& view, std::size_t i) const;
   /// prepare_neighbours() from its second pass on: expand_offsets_[0..n) holds the output counts and hr the
@@ -110,6 +139,7 @@ class Simulation {
   ParticleStore<2> store_;
   CellGrid<2> grid_;
   std::optional<GhostBuilder> ghosts_;
+  Integrator integrator_;
   std::unique_ptr<SweepBase> sweep_;
   std::vector<std::unique_ptr<Stage>> stages_;
   SweepLimits limits_;
@@ -118,10 +148,14 @@ class Simulation {
   RemovedFluid removed_, last_good_removed_;
   // Step workspace of prepare_neighbours (reused, so a step allocates nothing once sizes settle).
   std::vector<std::uint32_t> expand_src_, expand_offsets_;
+  std::vector<std::uint32_t> due_prefix_;  // Activity::due_prefix of the current substep
   std::vector<std::int8_t> expand_image_;
   std::vector<Vec<2>> expand_x_;  // the state before the current step (watchdog rollback)
+  Work work_;
   double time_ = 0.0;
   std::uint64_t step_ = 0;
+  std::uint64_t fine_steps_ = 0;
+  int last_substeps_ = 1;
   double dt_ = 0.0;
 };
 

@@ -43,6 +43,7 @@ struct SolverSettings {
   Geometry2 geometry;
   double cfl = 0.2;
   double dt_max = 1.0;  // upper bound on the step (s)
+  TimeStepping stepping = TimeStepping::global;
   WatchdogSettings watchdog;
 };
 

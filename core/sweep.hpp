@@ -5,7 +5,16 @@
 //
 // It also returns the time-step limit of PHYSICS.md:
 //   dt_max / C = min( min_i sqrt(h_i / |a_i|), min_i h_i / (c0 + max_j |h_ij v_ij.x_ij / (r_ij^2 + 0.01 h_ij^2)|) ).
+//
+// Time bins (core/integrator.hpp): particle i is in bin b_i = min(level_i, bin_cap) and steps dt0 / 2^b_i. A
+// pair steps at its finer member's rate, b_ij = max(b_i, b_j). A sweep at a substep where the bins >= active_bin
+// are due evaluates only the pairs with b_ij >= active_bin, each weighted by 2^-b_ij, and writes for every fluid
+// particle the weighted sums (kick, kick_rho: the integrator kicks v and rho by dt0 times them, so a pair's
+// impulse on i and on j is equal and opposite, at the same instant). A particle that is due (b_i >= active_bin)
+// also gets its rates a = 2^b_i kick and drho, and its limits, scaled by 2^b_i to a limit on dt0. With
+// bin_cap = 0 (one global step) every weight is 1 and the sweep is the plain one.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <tuple>
@@ -19,9 +28,35 @@
 namespace sph {
 
 struct SweepLimits {
-  double dt_force = std::numeric_limits<double>::infinity();  // min sqrt(h/|a|)
-  double dt_cfl = std::numeric_limits<double>::infinity();    // min h / (c0 + max mu)
-  std::size_t pairs = 0;                                      // interacting pairs visited
+  double dt_force = std::numeric_limits<double>::infinity();  // min 2^b sqrt(h/|a|)
+  double dt_cfl = std::numeric_limits<double>::infinity();    // min 2^b h / (c0 + max mu)
+  std::size_t pairs = 0;                                      // interacting pairs evaluated
+  int finest_bin = 0;                                         // largest bin of a due fluid particle
+  std::size_t candidates = 0;                                 // candidates checked (in the runs scanned)
+};
+
+/// 2^-b and 2^b for a bin b (a table: std::ldexp in the pair loop cost 6 % of a step).
+inline constexpr int kBinCount = 16;
+inline constexpr auto kBinWeight = [] {
+  std::array<double, kBinCount> w{};
+  for (int b = 0; b < kBinCount; ++b) w[static_cast<std::size_t>(b)] = 1.0 / static_cast<double>(1u << b);
+  return w;
+}();
+inline constexpr auto kBinScale = [] {
+  std::array<double, kBinCount> w{};
+  for (int b = 0; b < kBinCount; ++b) w[static_cast<std::size_t>(b)] = static_cast<double>(1u << b);
+  return w;
+}();
+
+/// Which pairs a sweep evaluates: those whose bin max(b_i, b_j) is at least active_bin, with
+/// b_i = min(level_i, bin_cap). The default (0, 0) is the single-rate sweep: every pair, weight 1.
+struct Activity {
+  int active_bin = 0;
+  int bin_cap = 0;
+  // Optional, with active_bin > 0: due_prefix[k] counts the due particles (fluid or ghost, bin >= active_bin)
+  // among the first k of the store. A particle that is not due skips every candidate run without one.
+  const std::uint32_t* due_prefix = nullptr;
+  int bin(std::int32_t level) const { return level < bin_cap ? static_cast<int>(level) : bin_cap; }
 };
 
 template <int D, class FluidEffects, class WallEffects>
@@ -30,8 +65,9 @@ class PairSweep {
   PairSweep(FluidEffects fluid, WallEffects wall, double c0, Vec<D> gravity)
       : fluid_(std::move(fluid)), wall_(std::move(wall)), c0_(c0), gravity_(std::move(gravity)) {}
 
-  /// Computes a and drho of every fluid particle (others get zero) from the current state.
-  SweepLimits operator()(ParticleView<D> s, const CellGrid<D>& grid) const {
+  /// Computes kick and kick_rho of every fluid particle, and a and drho of the due ones (others get zero),
+  /// from the current state.
+  SweepLimits operator()(ParticleView<D> s, const CellGrid<D>& grid, Activity act = {}) const {
     using Kernel = CubicSpline<D>;
     constexpr bool has_wall_effects = std::tuple_size_v<WallEffects> > 0;
     const double inf = std::numeric_limits<double>::infinity();
@@ -43,11 +79,15 @@ class PairSweep {
           if (s.kind[i] != Kind::fluid) {
             s.a[i].setZero();
             s.drho[i] = 0.0;
+            s.kick[i].setZero();
+            s.kick_rho[i] = 0.0;
             return lim;
           }
+          const int bi = act.bin(s.level[i]);
+          const bool due = bi >= act.active_bin;
           PairSums<D> acc;
           double mu_max = 0.0;
-          std::size_t pairs = 0;
+          std::size_t pairs = 0, candidates = 0;
           Pair<D> pr;
           pr.i = i;
           const Vec<D> xi = s.x[i];
@@ -56,6 +96,8 @@ class PairSweep {
           const double inv_hi = 1.0 / hi;
           pr.p_rho2_i = s.p[i] / (s.rho[i] * s.rho[i]);
           grid.for_each_candidate_run(xi, hi + grid.max_h(), [&](std::uint32_t b, std::uint32_t e) {
+            if (!due && act.due_prefix != nullptr && act.due_prefix[e] == act.due_prefix[b]) return;
+            candidates += e - b;
             for (std::uint32_t j = b; j < e; ++j) {
               const Vec<D> xij = xi - s.x[j];
               const double r2 = xij.squaredNorm();
@@ -68,31 +110,51 @@ class PairSweep {
               pr.hij = 0.5 * support;
               pr.vij = vi - s.v[j];
               pr.vx = pr.vij.dot(xij);
-              ++pairs;
               if (s.kind[j] == Kind::wall) {
+                pairs += due ? 1 : 0;
                 if constexpr (has_wall_effects) {
-                  std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, wall_);
+                  if (due) {
+                    pr.weight = kBinWeight[static_cast<std::size_t>(bi)];
+                    std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, wall_);
+                  }
                 }
                 continue;
               }
+              const int bj = act.bin(s.level[j]);
+              const int bij = bi > bj ? bi : bj;
+              if (bij < act.active_bin) continue;
+              ++pairs;
+              // 2^-b_ij scales every fluid pair term (each is linear in grad W); a power of two, so exact.
+              pr.weight = kBinWeight[static_cast<std::size_t>(bij)];
               const double inv_hij = s.h[j] == hi ? inv_hi : 1.0 / pr.hij;
-              pr.gradW = Kernel::gradient_factor_inv(pr.r, inv_hij) * xij;
+              pr.gradW = (pr.weight * Kernel::gradient_factor_inv(pr.r, inv_hij)) * xij;
               pr.mu = pr.hij * pr.vx / (r2 + 0.01 * pr.hij * pr.hij);
               std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, fluid_);
               mu_max = std::max(mu_max, std::abs(pr.mu));
             }
           });
-          acc.a += gravity_;
-          s.a[i] = acc.a;
-          s.drho[i] = acc.drho;
-          const double an = acc.a.norm();
-          lim.dt_force = an > 0.0 ? std::sqrt(hi / an) : inf;
-          lim.dt_cfl = hi / (c0_ + mu_max);
           lim.pairs = pairs;
+          lim.candidates = candidates;
+          if (!due) {  // only the pairs with a due partner: their impulses, no rates, no limits
+            s.kick[i] = acc.a;
+            s.kick_rho[i] = acc.drho;
+            return lim;
+          }
+          const double scale = kBinScale[static_cast<std::size_t>(bi)];
+          acc.a += kBinWeight[static_cast<std::size_t>(bi)] * gravity_;
+          s.kick[i] = acc.a;
+          s.kick_rho[i] = acc.drho;
+          s.a[i] = scale * acc.a;
+          s.drho[i] = scale * acc.drho;
+          const double an = s.a[i].norm();
+          lim.dt_force = an > 0.0 ? scale * std::sqrt(hi / an) : inf;
+          lim.dt_cfl = scale * (hi / (c0_ + mu_max));
+          lim.finest_bin = bi;
           return lim;
         },
         [](const SweepLimits& x, const SweepLimits& y) {
-          return SweepLimits{std::min(x.dt_force, y.dt_force), std::min(x.dt_cfl, y.dt_cfl), x.pairs + y.pairs};
+          return SweepLimits{std::min(x.dt_force, y.dt_force), std::min(x.dt_cfl, y.dt_cfl), x.pairs + y.pairs,
+                             std::max(x.finest_bin, y.finest_bin), x.candidates + y.candidates};
         });
   }
 

@@ -21,7 +21,7 @@ namespace sph {
 class SweepBase {
  public:
   virtual ~SweepBase() = default;
-  virtual SweepLimits run(ParticleView<2> s, const CellGrid<2>& grid) const = 0;
+  virtual SweepLimits run(ParticleView<2> s, const CellGrid<2>& grid, Activity act = {}) const = 0;
   /// The effects in the pack, e.g. "continuity+pressure+viscosity|lj" (fluid pairs | wall pairs).
   virtual const char* name() const = 0;
 };
@@ -31,7 +31,9 @@ class SweepImpl final : public SweepBase {
  public:
   SweepImpl(Fluid f, Wall w, double c0, Vec<2> g, std::string name)
       : sweep_(std::move(f), std::move(w), c0, std::move(g)), name_(std::move(name)) {}
-  SweepLimits run(ParticleView<2> s, const CellGrid<2>& grid) const override { return sweep_(s, grid); }
+  SweepLimits run(ParticleView<2> s, const CellGrid<2>& grid, Activity act = {}) const override {
+    return sweep_(s, grid, act);
+  }
   const char* name() const override { return name_.c_str(); }
 
  private:

@@ -17,6 +17,9 @@ enum class Kind : std::uint8_t { fluid = 0, wall = 1, ghost = 2 };
 /// (`fresh_merge` until the refinement check after that merge, which does not split it, then `merge`).
 enum class Origin : std::uint8_t { setup = 0, split = 1, fresh_merge = 2, merge = 3 };
 
+/// time.stepping (core/integrator.hpp): one global step (the paper's), or power-of-two steps per refinement level.
+enum class TimeStepping { global, per_level };
+
 using Index = std::uint32_t;
 using ParticleId = std::uint64_t;
 

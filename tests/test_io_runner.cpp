@@ -172,6 +172,37 @@ TEST(Runner, ResumedRunWithCoarseningIsBitwiseIdenticalToTheUninterruptedOne) {
   EXPECT_EQ(lines(c_dir / "series.csv"), lines(a_dir / "series.csv"));
 }
 
+// The same with per-level time steps (time.stepping = "per_level") and two levels of refinement in a zone: a
+// checkpoint is written between steps, where every bin is synchronised, and holds the rates (a, drho, kick) the
+// next step opens with.
+TEST(Runner, ResumedRunWithPerLevelStepsIsBitwiseIdenticalToTheUninterruptedOne) {
+  TempFolder tmp;
+  scene::Scene s = tiny_scene();
+  scene::Refinement r;
+  r.criterion = scene::Criterion::zone;
+  r.zone = scene::Rect{Vec<2>(0.5, 0.0), Vec<2>(1.0, 0.4)};
+  r.check_interval = 10;
+  r.max_level = 2;
+  s.effects.refinement = r;
+  s.time.stepping = TimeStepping::per_level;
+  s.time.end = 0.15;
+  const fs::path a_dir = tmp.path() / "a", c_dir = tmp.path() / "c";
+  scene::Runner a(s, scene::RunOptions{a_dir, std::nullopt, 0.05});
+  a.start();
+  while (!fs::exists(io::RunFiles{a_dir}.checkpoint())) a.advance();
+  fs::copy(a_dir, c_dir, fs::copy_options::recursive);
+  a.run();
+  int finest = 0;
+  const auto& st = a.simulation().store();
+  for (std::size_t i = 0; i < st.size(); ++i) finest = std::max(finest, static_cast<int>(st.level[i]));
+  EXPECT_EQ(finest, 2) << "the zone should hold level-2 particles, stepping in their own bin";
+  scene::Runner c(s, scene::RunOptions{c_dir, c_dir / "checkpoint.h5", 0.05});
+  c.run();
+  EXPECT_EQ(c.simulation().step_count(), a.simulation().step_count());
+  expect_bitwise_equal(c.simulation().store(), a.simulation().store());
+  EXPECT_EQ(lines(c_dir / "series.csv"), lines(a_dir / "series.csv"));
+}
+
 // A finished run extended with a later time.end (--resume --set time.end=...) is the run that went to the
 // later end without stopping, bitwise, at 1 and 2 threads. The first run's last step is shortened to land on
 // its end (0.043 s falls between steps), which the longer run never does.

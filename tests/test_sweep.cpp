@@ -12,6 +12,7 @@
 #include <limits>
 #include <vector>
 
+#include "core/integrator.hpp"
 #include "core/kernel.hpp"
 #include "core/scene/scene_builder.hpp"
 #include "core/scene/scene_parser.hpp"
@@ -117,45 +118,68 @@ TEST(Sweep, MixedLevelCloudHasZeroNetForceAndTorque) {
 // (b) Brute-force twin: eqs. (5), (6), (9), (10) over all pairs, written from PHYSICS.md.
 
 struct Reference {
-  std::vector<double> drho, drho_scale;
-  std::vector<Vec<2>> a;
+  std::vector<double> drho, drho_scale, kick_rho;
+  std::vector<Vec<2>> a, kick;
+  std::vector<std::uint8_t> due;
   std::vector<double> a_scale;
   double dt_force = std::numeric_limits<double>::infinity();
   double dt_cfl = std::numeric_limits<double>::infinity();
   std::size_t pairs = 0;
 };
 
-Reference brute_force(const ParticleStore<2>& s, const SolverSettings& st) {
+// With time bins (sph::Activity, core/sweep.hpp): a particle's bin is min(level, cap); a pair is evaluated
+// when the larger of its two bins is at least the active bin, its terms weighted by 2^-(that bin); gravity
+// and the wall terms belong to a due particle's own bin. `kick` holds the weighted sums; for a due particle,
+// a = 2^b kick and its limits are scaled by 2^b. The default activity is the single-rate sweep.
+Reference brute_force(const ParticleStore<2>& s, const SolverSettings& st, sph::Activity act = {}) {
   using K = sph::CubicSpline<2>;
   const std::size_t n = s.size();
   Reference ref;
   ref.drho.assign(n, 0.0);
   ref.drho_scale.assign(n, 0.0);
+  ref.kick_rho.assign(n, 0.0);
   ref.a.assign(n, Vec<2>::Zero());
+  ref.kick.assign(n, Vec<2>::Zero());
+  ref.due.assign(n, 0);
   ref.a_scale.assign(n, 0.0);
   const Vec<2> g = st.gravity.value_or(Vec<2>::Zero());
   const double c = st.eos.c0;
+  const auto bin = [&](std::size_t k) { return std::min(static_cast<int>(s.level[k]), act.bin_cap); };
   for (std::size_t i = 0; i < n; ++i) {
     if (s.kind[i] != Kind::fluid) continue;
-    Vec<2> ai = g;
+    const int bi = bin(i);
+    const bool due = bi >= act.active_bin;
+    const double wi = std::pow(2.0, -bi);
+    Vec<2> ai = due ? Vec<2>(wi * g) : Vec<2>(Vec<2>::Zero());
     double scale = g.norm(), drho = 0.0, drho_scale = 0.0, mu_max = 0.0;
     for (std::size_t j = 0; j < n; ++j) {
       if (j == i) continue;
       const Vec<2> xij = s.x[i] - s.x[j];
       const double r = xij.norm();
       if (!(r < s.h[i] + s.h[j])) continue;
-      ++ref.pairs;
       if (s.kind[j] == Kind::wall) {  // eq. (10), r0 = r0_factor d_i
+        if (!due) continue;
+        ++ref.pairs;
         if (!st.lennard_jones) continue;
         const double r0 = st.lennard_jones->r0_factor * s.d[i];
         if (r >= r0 || r == 0.0) continue;
-        const Vec<2> f = st.lennard_jones->strength * (std::pow(r0 / r, 12) - std::pow(r0 / r, 6)) * xij / (r * r);
+        const Vec<2> f = wi * st.lennard_jones->strength * (std::pow(r0 / r, 12) - std::pow(r0 / r, 6)) * xij / (r * r);
         ai += f;
         scale += f.norm();
         continue;
       }
+      const int bij = std::max(bi, bin(j));
+      if (bij < act.active_bin) continue;
+      ++ref.pairs;
+      const double w = std::pow(2.0, -bij);
       const double hij = 0.5 * (s.h[i] + s.h[j]);
-      const Vec<2> gradW = r > 0.0 ? Vec<2>(K::derivative(r, hij) * xij / r) : Vec<2>(Vec<2>::Zero());
+      const Vec<2> gradW = r > 0.0 ? Vec<2>(w * K::derivative(r, hij) * xij / r) : Vec<2>(Vec<2>::Zero());
+      // Near the edge of the support grad W goes as (2 - q)^2, so an ulp of q (the sweep forms q = r (1/h_ij),
+      // this r / h_ij) moves the term by 2 q / (2 - q) ulps: the term's share of the scale carries that factor.
+      // (With many neighbours other terms dominate the scale; a particle whose only due pair sits at the edge
+      // of its support does not.)
+      const double q = r / hij;
+      const double cond = q >= 1.0 && q < 2.0 ? 1.0 + 2.0 * q / (2.0 - q) : 1.0;
       const Vec<2> vij = s.v[i] - s.v[j];
       double dr = s.m[j] * vij.dot(gradW);  // eq. (5)
       if (st.density_diffusion) {  // delta-SPH: psi = (rho_j - rho_i) - (rho0/c0^2) g.(x_j - x_i)
@@ -165,7 +189,7 @@ Reference brute_force(const ParticleStore<2>& s, const SolverSettings& st) {
               s.m[j] / s.rho[j];
       }
       drho += dr;
-      drho_scale += std::abs(dr);
+      drho_scale += cond * std::abs(dr);
       double bracket = s.p[i] / (s.rho[i] * s.rho[i]) + s.p[j] / (s.rho[j] * s.rho[j]);  // eq. (6)
       const double mu = hij * vij.dot(xij) / (r * r + 0.01 * hij * hij);
       mu_max = std::max(mu_max, std::abs(mu));
@@ -182,14 +206,19 @@ Reference brute_force(const ParticleStore<2>& s, const SolverSettings& st) {
       }
       const Vec<2> f = -s.m[j] * bracket * gradW;
       ai += f;
-      scale += f.norm();
+      scale += cond * f.norm();
     }
-    ref.a[i] = ai;
+    ref.kick[i] = ai;
+    ref.kick_rho[i] = drho;
     ref.a_scale[i] = scale;
-    ref.drho[i] = drho;
     ref.drho_scale[i] = drho_scale;
-    if (ai.norm() > 0.0) ref.dt_force = std::min(ref.dt_force, std::sqrt(s.h[i] / ai.norm()));
-    ref.dt_cfl = std::min(ref.dt_cfl, s.h[i] / (c + mu_max));
+    if (!due) continue;
+    ref.due[i] = 1;
+    const double up = std::pow(2.0, bi);
+    ref.a[i] = up * ai;
+    ref.drho[i] = up * drho;
+    if (ai.norm() > 0.0) ref.dt_force = std::min(ref.dt_force, up * std::sqrt(s.h[i] / ref.a[i].norm()));
+    ref.dt_cfl = std::min(ref.dt_cfl, up * s.h[i] / (c + mu_max));
   }
   return ref;
 }
@@ -201,8 +230,8 @@ Reference brute_force(const ParticleStore<2>& s, const SolverSettings& st) {
 /// leaves a factor ~100; a missing or extra pair changes a sum by a whole term, or, at the edge of the support
 /// where grad W vanishes, changes the pair count, which must match exactly.
 void expect_rates_match_brute_force(const ParticleStore<2>& s, const sph::SweepLimits& lim, const SolverSettings& st,
-                                    const char* what) {
-  const Reference ref = brute_force(s, st);
+                                    const char* what, sph::Activity act = {}) {
+  const Reference ref = brute_force(s, st, act);
   std::size_t checked = 0;
   for (std::size_t i = 0; i < s.size(); ++i) {
     if (s.kind[i] != Kind::fluid) {
@@ -210,11 +239,18 @@ void expect_rates_match_brute_force(const ParticleStore<2>& s, const sph::SweepL
       EXPECT_EQ(s.drho[i], 0.0) << what << ": non-fluid " << i;
       continue;
     }
+    // The weights are powers of two and the bins' scales undo them exactly, so the single-rate tolerance holds.
+    EXPECT_LE((s.kick[i] - ref.kick[i]).norm(), 1e-12 * ref.a_scale[i] + 1e-300) << what << ": kick of " << i;
+    EXPECT_LE(std::abs(s.kick_rho[i] - ref.kick_rho[i]), 1e-12 * ref.drho_scale[i] + 1e-300)
+        << what << ": kick_rho of " << i;
+    if (ref.due[i] == 0) continue;  // a and drho of a particle that is not due are not the sweep's to write
     ++checked;
-    EXPECT_LE((s.a[i] - ref.a[i]).norm(), 1e-12 * ref.a_scale[i] + 1e-300) << what << ": a of " << i;
-    EXPECT_LE(std::abs(s.drho[i] - ref.drho[i]), 1e-12 * ref.drho_scale[i] + 1e-300) << what << ": drho of " << i;
+    EXPECT_LE((s.a[i] - ref.a[i]).norm(), 1e-12 * std::pow(2.0, s.level[i]) * ref.a_scale[i] + 1e-300)
+        << what << ": a of " << i;
+    EXPECT_LE(std::abs(s.drho[i] - ref.drho[i]), 1e-12 * std::pow(2.0, s.level[i]) * ref.drho_scale[i] + 1e-300)
+        << what << ": drho of " << i;
   }
-  EXPECT_GT(checked, 100u);
+  EXPECT_GT(checked, act.active_bin == 0 ? 100u : 20u);
   EXPECT_EQ(lim.pairs, ref.pairs) << what;
   EXPECT_NEAR(lim.dt_force, ref.dt_force, 1e-12 * ref.dt_force) << what;
   EXPECT_NEAR(lim.dt_cfl, ref.dt_cfl, 1e-12 * ref.dt_cfl) << what;
@@ -310,6 +346,57 @@ TEST(Sweep, EqualsBruteForceWithLennardJonesWalls) {
     for (std::size_t i = 0; i < s.size(); ++i)
       if (with.a[i][1] - without.a[i][1] > 1e-6 * with.a_scale[i]) ++repelled;  // pushed up, away from y = 0
     EXPECT_GT(repelled, 20u);
+  }
+}
+
+// Time bins: a cloud on levels 0, 1 and 2, swept at each active bin of a three-bin step (with and without the
+// due-particle prefix that lets particles that are not due skip candidate runs), against the brute force of the
+// same weighted sums. Particles that are not due keep their rates (a sentinel here).
+TEST(Sweep, TimeBinsEqualBruteForce) {
+  const SolverSettings st = twin_settings(true, true);
+  ParticleStore<2> s = twin_cloud(st, 12u);
+  std::size_t fine = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] == Kind::wall || s.level[i] != 1 || i % 2 != 0) continue;
+    s.level[i] = 2;  // a level-2 particle: half a level-1 particle's spacing and h, a quarter of its mass
+    s.d[i] *= 0.5;
+    s.h[i] *= 0.5;
+    s.m[i] *= 0.25;
+    fine += s.kind[i] == Kind::fluid;
+  }
+  ASSERT_GT(fine, 50u);
+  CellGrid<2> grid;
+  build_grid(s, grid);
+  const auto sweep = sph::make_sweep(st);
+  for (const int active : {2, 1, 0}) {
+    for (const bool skip : {false, true}) {
+      SCOPED_TRACE(testing::Message() << "active bin " << active << (skip ? ", with the prefix" : ""));
+      sph::Activity act{active, sph::Integrator::kMaxBin};
+      std::vector<std::uint32_t> prefix(s.size() + 1, 0);
+      for (std::size_t i = 0; i < s.size(); ++i)
+        prefix[i + 1] = prefix[i] + (s.kind[i] != Kind::wall && act.bin(s.level[i]) >= active ? 1u : 0u);
+      if (skip) act.due_prefix = prefix.data();
+      const Vec<2> sentinel(1234.5, -6789.0);
+      for (std::size_t i = 0; i < s.size(); ++i) {
+        s.a[i] = sentinel;
+        s.drho[i] = 42.0;
+      }
+      const sph::SweepLimits lim = sweep->run(s.view(), grid, act);
+      expect_rates_match_brute_force(s, lim, st, "bins", act);
+      std::size_t kept = 0, touched = 0;
+      for (std::size_t i = 0; i < s.size(); ++i) {
+        if (s.kind[i] != Kind::fluid || s.level[i] >= active) continue;
+        EXPECT_EQ(s.a[i], sentinel) << i;
+        EXPECT_EQ(s.drho[i], 42.0) << i;
+        ++kept;
+        touched += s.kick[i] != Vec<2>::Zero();
+      }
+      if (active > 0) {
+        EXPECT_GT(kept, 50u);
+        EXPECT_GT(touched, 20u) << "coarser particles take the impulses of their due neighbours";
+        EXPECT_EQ(lim.finest_bin, 2);
+      }
+    }
   }
 }
 

@@ -53,10 +53,10 @@ THROWN = {
 }
 
 UNITS = {"acceleration": "m/s^2", "density": "kg/m^3", "density_half": "kg/m^3", "density_rate": "kg/m^3/s", "id": "1",
-         "kind": "1", "level": "1", "level_time": "s", "mass": "kg/m", "origin": "1", "position": "m", "pressure": "Pa", "smoothing_length": "m",
+         "kick_density_rate": "kg/m^3/s", "kick_rate": "m/s^2", "kind": "1", "level": "1", "level_time": "s", "mass": "kg/m", "origin": "1", "position": "m", "pressure": "Pa", "smoothing_length": "m",
          "spacing": "m", "velocity": "m/s", "velocity_half": "m/s"}
 
-FIELDS = ["acceleration", "density", "density_half", "density_rate", "id", "kind", "level", "level_time", "mass", "origin",
+FIELDS = ["acceleration", "density", "density_half", "density_rate", "id", "kick_density_rate", "kick_rate", "kind", "level", "level_time", "mass", "origin",
           "position",
           "pressure", "smoothing_length", "spacing", "velocity", "velocity_half"]
 

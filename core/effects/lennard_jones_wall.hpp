@@ -15,7 +15,7 @@ struct LennardJonesWall {
     if (pr.r >= r0 || pr.r2 <= 0.0) return;
     const double q2 = r0 * r0 / pr.r2;
     const double q6 = q2 * q2 * q2;
-    acc.a += (strength * (q6 * q6 - q6) / pr.r2) * pr.xij;
+    acc.a += (pr.weight * (strength * (q6 * q6 - q6) / pr.r2)) * pr.xij;
   }
 };
 

@@ -18,7 +18,8 @@ struct Pair {
   double vx = 0;   // v_ij . x_ij
   double mu = 0;   // h_ij v_ij.x_ij / (r_ij^2 + 0.01 h_ij^2), eq. (9) and the time-step limit
   double p_rho2_i = 0;  // p_i / rho_i^2, fixed for particle i
-  Vec<D> gradW = Vec<D>::Zero();  // grad_i W(x_ij, h_ij)
+  double weight = 1.0;  // 2^-b_ij, the pair's share of dt0 (core/sweep.hpp); gradW already carries it
+  Vec<D> gradW = Vec<D>::Zero();  // weight * grad_i W(x_ij, h_ij)
 };
 
 /// The running sums of particle i over its neighbours.

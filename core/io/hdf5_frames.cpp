@@ -262,6 +262,7 @@ void write_checkpoint(const std::filesystem::path& file, const ParticleStore<2>&
     write_attribute(g, "frame_count", H5T_NATIVE_UINT64, state.frame_count);
     write_attribute(g, "next_checkpoint", H5T_NATIVE_UINT64, state.next_checkpoint);
     write_attribute(g, "particle_steps", H5T_NATIVE_UINT64, state.particle_steps);
+    write_attribute(g, "fine_steps", H5T_NATIVE_UINT64, state.fine_steps);
     write_attribute(g, "initial_mass", H5T_NATIVE_DOUBLE, state.initial_mass);
     write_attribute(g, "initial_momentum_x", H5T_NATIVE_DOUBLE, state.initial_momentum_x);
     write_attribute(g, "initial_momentum_y", H5T_NATIVE_DOUBLE, state.initial_momentum_y);
@@ -306,6 +307,8 @@ CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore
   s.frame_count = read_attribute<std::uint64_t>(g, "frame_count", H5T_NATIVE_UINT64);
   s.next_checkpoint = read_attribute<std::uint64_t>(g, "next_checkpoint", H5T_NATIVE_UINT64);
   s.particle_steps = read_attribute<std::uint64_t>(g, "particle_steps", H5T_NATIVE_UINT64);
+  // Absent from checkpoints written before per-level steps: every step was one step of the finest bin then.
+  s.fine_steps = has_attribute(g, "fine_steps") ? read_attribute<std::uint64_t>(g, "fine_steps", H5T_NATIVE_UINT64) : s.step;
   s.initial_mass = read_attribute<double>(g, "initial_mass", H5T_NATIVE_DOUBLE);
   s.initial_momentum_x = read_attribute<double>(g, "initial_momentum_x", H5T_NATIVE_DOUBLE);
   s.initial_momentum_y = read_attribute<double>(g, "initial_momentum_y", H5T_NATIVE_DOUBLE);

@@ -59,6 +59,7 @@ struct CheckpointState {
   std::uint64_t frame_count = 0; // frames written (the next frame file's number)
   std::uint64_t next_checkpoint = 0;
   std::uint64_t particle_steps = 0;
+  std::uint64_t fine_steps = 0;   // Simulation::fine_step_count (absent before per-level steps: = step)
   double initial_mass = 0.0;      // the run's state at t = 0, for the drift in the summary
   double initial_momentum_x = 0.0;
   double initial_momentum_y = 0.0;

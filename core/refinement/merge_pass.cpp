@@ -137,6 +137,8 @@ MergeResult merge_families(ParticleStore<2>& store, const std::vector<std::uint8
     s.origin[k] = Origin::fresh_merge;
     s.a[k].setZero();  // the rates are re-evaluated after the pass
     s.drho[k] = 0.0;
+    s.kick[k].setZero();
+    s.kick_rho[k] = 0.0;
   });
   // Ghosts go too, as in the split pass: the solver rebuilds them for the new set.
   store.compact([&](std::size_t i) { return drop[i] == 0 && store.kind[i] != Kind::ghost; });

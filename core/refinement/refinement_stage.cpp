@@ -31,8 +31,11 @@ RefinementStage::RefinementStage(const RefinementSettings& settings)
     : settings_(settings), criterion_(make_criterion(settings)) {}
 
 bool RefinementStage::after_step(Simulation& sim) {
+  // Every check_interval steps of the finest bin: a check after the step in which their count passed a multiple
+  // of the interval (with one global step, every check_interval-th step).
   const auto interval = static_cast<std::uint64_t>(std::max(1, settings_.check_interval));
-  if (sim.step_count() % interval != 0) return false;
+  const std::uint64_t fine = sim.fine_step_count();
+  if ((fine - static_cast<std::uint64_t>(sim.last_substeps())) / interval == fine / interval) return false;
   ParticleStore<2>& store = sim.store();
   std::vector<std::uint8_t> marks(store.size(), 0);
   criterion_->mark(store, marks);

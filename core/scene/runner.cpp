@@ -72,6 +72,8 @@ Runner::Runner(Scene scene, RunOptions options)
       dt = std::min(state.dt / original.time.cfl * scene_.time.cfl, scene_.time.dt_max);
     }
     sim_.set_clock(state.time, state.step, dt);
+    sim_.set_fine_step_count(state.fine_steps);
+    sim_.store_restored();
     next_row_ = state.next_row;
     next_frame_ = state.next_frame;
     frame_count_ = state.frame_count;
@@ -249,6 +251,7 @@ void Runner::write_checkpoint() {
   s.frame_count = frame_count_;
   s.next_checkpoint = next_checkpoint_;
   s.particle_steps = particle_steps_;
+  s.fine_steps = sim_.fine_step_count();
   s.initial_mass = initial_mass_;
   s.initial_momentum_x = initial_momentum_[0];
   s.initial_momentum_y = initial_momentum_[1];
@@ -298,6 +301,21 @@ void Runner::write_summary(const RunSummary& r, const FailureReport* failure) {
   j["particle_steps"] = r.particle_steps;
   j["particle_steps_per_second"] = r.wall_seconds > 0.0 ? static_cast<double>(r.particle_steps) / r.wall_seconds : 0.0;
   j["fluid_per_level"] = r.final.per_level;
+  // The work of this invocation: force evaluations per level (a particle evaluated when due), pair
+  // interactions, neighbour candidates checked, and sweeps (substeps). With time.stepping = "global" a step is
+  // one sweep of every particle.
+  {
+    const Work& w = sim_.work();
+    std::size_t levels = 1;
+    for (std::size_t l = 0; l < w.evaluations.size(); ++l)
+      if (w.evaluations[l] > 0) levels = l + 1;
+    j["stepping"] = scene_.time.stepping == TimeStepping::global ? "global" : "per_level";
+    j["force_evaluations_per_level"] =
+        std::vector<std::uint64_t>(w.evaluations.begin(), w.evaluations.begin() + static_cast<std::ptrdiff_t>(levels));
+    j["pair_interactions"] = w.pairs;
+    j["neighbour_candidates"] = w.candidates;
+    j["sweeps"] = w.substeps;
+  }
   j["removed_particles"] = r.final.removed;
   j["removed_mass"] = r.final.removed_mass;
   j["mass_drift"] = r.mass_drift;

@@ -137,6 +137,7 @@ struct Time {
   double cfl = 0.2;
   std::optional<double> output_interval;  // default end / 100
   double dt_max = 1.0;
+  TimeStepping stepping = TimeStepping::global;  // "global" or "per_level" (core/integrator.hpp)
   bool operator==(const Time&) const = default;
 
   double interval() const { return output_interval.value_or(end / 100.0); }

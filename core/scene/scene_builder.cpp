@@ -58,6 +58,7 @@ SolverSettings solver_settings(const Scene& scene) {
   for (const Rect& o : scene.obstacles) s.geometry.obstacles.push_back(box(o));
   s.cfl = scene.time.cfl;
   s.dt_max = scene.time.dt_max;
+  s.stepping = scene.time.stepping;
   return s;
 }
 

@@ -294,12 +294,14 @@ Effects parse_effects(const Json& j, const std::string& path) {
 }
 
 Time parse_time(const Json& j, const std::string& path) {
-  ObjectReader r(j, path, {"end", "cfl", "output_interval", "dt_max"});
+  ObjectReader r(j, path, {"end", "cfl", "output_interval", "dt_max", "stepping"});
   Time t;
   t.end = r.number("end");
   t.cfl = r.number("cfl", 0.2);
   t.output_interval = r.optional_number("output_interval");
   t.dt_max = r.number("dt_max", 1.0);
+  t.stepping = r.choice<TimeStepping>(
+      "stepping", {{"global", TimeStepping::global}, {"per_level", TimeStepping::per_level}}, TimeStepping::global);
   return t;
 }
 

@@ -99,6 +99,7 @@ Json scene_to_json(const Scene& s) {
   Json t{{"end", s.time.end}, {"cfl", s.time.cfl}};
   if (s.time.output_interval) t["output_interval"] = *s.time.output_interval;
   t["dt_max"] = s.time.dt_max;
+  t["stepping"] = s.time.stepping == TimeStepping::global ? "global" : "per_level";
   j["time"] = t;
 
   if (!s.probes.empty()) {

@@ -1,0 +1,96 @@
+#pragma once
+// Time integration: kick-drift-kick leapfrog (PHYSICS.md), with one global step or power-of-two time bins
+// per refinement level. The driver (core/simulation.cpp) owns the loops and the force evaluations; this
+// component says what each particle does in them, and which pairs each evaluation must cover.
+//
+// One step advances the fluid by dt0 in K = 2^B substeps of tau = dt0 / K, B the finest bin present. Particle
+// i is in bin b_i = min(level_i, bin_cap) (bin_cap = 0: one global step) and is due every 2^(B - b_i)
+// substeps; a pair steps at its finer member's rate, b_ij = max(b_i, b_j). The step is:
+//   open:   vh = v + (dt0 2^-b / 2) a,  rhoh = rho + (dt0 2^-b / 2) drho       (a, drho: the last rates)
+//   for k = 1..K:
+//     drift:   x += tau vh for every fluid particle, and the prediction where it is needed:
+//              v = vh + (t_k - t_mid) a, rho = rhoh + (t_k - t_mid) drho, t_mid the middle of i's own step
+//     forces:  the pairs with b_ij >= the active bin of substep k (core/sweep.hpp), each weighted by 2^-b_ij
+//     kick:    k < K:  vh += dt0 kick, rhoh += dt0 kick_rho  (a closing and an opening half-kick at once)
+//              k = K:  v = vh + (dt0 / 2) kick, rho = rhoh + (dt0 / 2) kick_rho  (every pair closes)
+// This is a multiple-time-step leapfrog split by pairs (r-RESPA): every pair impulse is applied to both
+// members at the same instant, equal and opposite and along x_ij, so linear and angular momentum are exact to
+// rounding whatever the bins. With bin_cap = 0 (B = 0, K = 1) it is, operation for operation, the single-rate
+// scheme:
+//   v_h = v_n + dt/2 a_n,  x_{n+1} = x_n + dt v_h,  forces at x_{n+1} with v = v_h + dt/2 a_n,
+//   v_{n+1} = v_h + dt/2 a_{n+1}   (and the same for rho).
+// Coarse particles take their own pairs' forces once per coarse step; the pairs they share with finer ones are
+// evaluated at the finer rate, from both sides. Steps end with every bin synchronised, so refinement,
+// coarsening, output and checkpoints only ever see synchronised particles.
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+#include "core/equation_of_state.hpp"
+#include "core/particle_store.hpp"
+#include "core/solver_settings.hpp"
+#include "core/sweep.hpp"
+
+namespace sph {
+
+class Integrator {
+ public:
+  /// The finest bin a step may have: 2^kMaxBin substeps. Levels beyond it share its bin.
+  static constexpr int kMaxBin = kBinCount - 1;
+  static_assert(kMaxBin < 31, "1 << bins must fit an int");
+
+  Integrator(TimeStepping mode, TaitEquationOfState eos) : mode_(mode), eos_(eos) {}
+
+  TimeStepping mode() const { return mode_; }
+  int bin_cap() const { return mode_ == TimeStepping::global ? 0 : kMaxBin; }
+  int bin(std::int32_t level) const { return Activity{0, bin_cap()}.bin(level); }
+
+  /// The pairs the evaluation after substep k (1..2^finest) covers: those of the bins due at t_k.
+  Activity activity(int k, int finest) const {
+    const int substeps = 1 << finest;
+    if (k >= substeps) return {0, bin_cap()};  // the end of the step: every bin
+    int trailing = 0;                          // k is a multiple of 2^(finest - b) for b >= finest - trailing
+    while (((k >> trailing) & 1) == 0) ++trailing;
+    return {finest - trailing, bin_cap()};
+  }
+
+  /// Opening half-kick of a step of dt0 (fluid particles only).
+  template <int D>
+  void open(const ParticleView<D>& s, std::size_t i, double dt0) const {
+    const double half = (0.5 * dt0) * kBinWeight[static_cast<std::size_t>(bin(s.level[i]))];
+    s.vh[i] = s.v[i] + half * s.a[i];
+    s.rhoh[i] = s.rho[i] + half * s.drho[i];
+  }
+
+  /// Drift over substep k of 2^finest (tau = dt0 / 2^finest) and the prediction of v, rho and p at t_k.
+  template <int D>
+  void drift(const ParticleView<D>& s, std::size_t i, double tau, int k, int finest) const {
+    s.x[i] += tau * s.vh[i];
+    const int period = 1 << (finest - bin(s.level[i]));  // substeps per step of i's bin
+    const int start = ((k - 1) / period) * period;       // substep at which i's current step began
+    const double offset = static_cast<double>(2 * (k - start) - period) * (0.5 * tau);  // t_k - t_mid
+    s.v[i] = s.vh[i] + offset * s.a[i];
+    s.rho[i] = s.rhoh[i] + offset * s.drho[i];
+    s.p[i] = eos_.pressure(s.rho[i]);
+  }
+
+  /// Kick after the evaluation of substep k: full (closing and opening) inside the step, closing at its end.
+  template <int D>
+  void kick(const ParticleView<D>& s, std::size_t i, double dt0, bool closing) const {
+    if (closing) {
+      const double half = 0.5 * dt0;
+      s.v[i] = s.vh[i] + half * s.kick[i];
+      s.rho[i] = s.rhoh[i] + half * s.kick_rho[i];
+      s.p[i] = eos_.pressure(s.rho[i]);
+    } else {
+      s.vh[i] += dt0 * s.kick[i];
+      s.rhoh[i] += dt0 * s.kick_rho[i];
+    }
+  }
+
+ private:
+  TimeStepping mode_;
+  TaitEquationOfState eos_;
+};
+
+}  // namespace sph
