@@ -138,7 +138,7 @@ TEST(Integrator, ThreeLevelCloudPerLevelConservesMomentumAndAngularMomentumOver1
 TEST(Integrator, PerLevelTakesLongerCoarseStepsThanTheGlobalStep) {
   Simulation global = three_level_cloud(TimeStepping::global);
   Simulation per_level = three_level_cloud(TimeStepping::per_level);
-  const double end = 0.05;
+  const double end = test::short_runs() ? 0.02 : 0.05;  // shorter under the sanitizer preset
   global.run_until(end);
   per_level.run_until(end);
   EXPECT_GT(static_cast<double>(global.step_count()), 2.5 * static_cast<double>(per_level.step_count()))
@@ -167,7 +167,8 @@ TEST(Integrator, PerLevelIsBitwiseIdenticalAtOneAndTwoThreads) {
   for (int t = 1; t <= 2; ++t) {
     omp_set_num_threads(t);
     Simulation sim = three_level_cloud(TimeStepping::per_level);
-    for (int k = 0; k < 100; ++k) sim.step();
+    const int steps = test::short_runs() ? 30 : 100;  // shorter under the sanitizer preset
+    for (int k = 0; k < steps; ++k) sim.step();
     sim.remove_ghosts();
     result[t - 1] = sim.store();
   }
