@@ -143,10 +143,28 @@ TEST(Runner, ResumedRunIsBitwiseIdenticalToTheUninterruptedOne) {
   EXPECT_FALSE(has_temporary_files(c_dir));
 }
 
+/// Runs `s` with a checkpoint every 0.05 s, resumes a copy from the first checkpoint, and expects the resumed run
+/// to end bitwise as the uninterrupted one. `check` looks at the uninterrupted run's end state first.
+template <class Check>
+void expect_resume_is_bitwise(const scene::Scene& s, Check&& check) {
+  TempFolder tmp;
+  const fs::path a_dir = tmp.path() / "a", c_dir = tmp.path() / "c";
+  scene::Runner a(s, scene::RunOptions{a_dir, std::nullopt, 0.05});
+  a.start();
+  while (!fs::exists(io::RunFiles{a_dir}.checkpoint())) a.advance();
+  fs::copy(a_dir, c_dir, fs::copy_options::recursive);
+  a.run();
+  check(a.simulation().store());
+  scene::Runner c(s, scene::RunOptions{c_dir, c_dir / "checkpoint.h5", 0.05});
+  c.run();
+  EXPECT_EQ(c.simulation().step_count(), a.simulation().step_count());
+  expect_bitwise_equal(c.simulation().store(), a.simulation().store());
+  EXPECT_EQ(lines(c_dir / "series.csv"), lines(a_dir / "series.csv"));
+}
+
 // The same with coarsening: families split in a zone at the toe of the column and merge as the toe runs out
 // of it; the merge state (level_time, origin) travels in the checkpoint like every field.
 TEST(Runner, ResumedRunWithCoarseningIsBitwiseIdenticalToTheUninterruptedOne) {
-  TempFolder tmp;
   scene::Scene s = tiny_scene();
   scene::Refinement r;
   r.criterion = scene::Criterion::zone;
@@ -156,28 +174,18 @@ TEST(Runner, ResumedRunWithCoarseningIsBitwiseIdenticalToTheUninterruptedOne) {
   r.coarsening->hold_time = 0.005;
   s.effects.refinement = r;
   s.time.end = 0.15;
-  const fs::path a_dir = tmp.path() / "a", c_dir = tmp.path() / "c";
-  scene::Runner a(s, scene::RunOptions{a_dir, std::nullopt, 0.05});
-  a.start();
-  while (!fs::exists(io::RunFiles{a_dir}.checkpoint())) a.advance();
-  fs::copy(a_dir, c_dir, fs::copy_options::recursive);
-  a.run();
-  std::size_t merged = 0;
-  const auto& st = a.simulation().store();
-  for (std::size_t i = 0; i < st.size(); ++i) merged += st.origin[i] == Origin::merge || st.origin[i] == Origin::fresh_merge;
-  EXPECT_GT(merged, 0u) << "no family merged: the test would not see the merge's state";
-  scene::Runner c(s, scene::RunOptions{c_dir, c_dir / "checkpoint.h5", 0.05});
-  c.run();
-  EXPECT_EQ(c.simulation().step_count(), a.simulation().step_count());
-  expect_bitwise_equal(c.simulation().store(), a.simulation().store());
-  EXPECT_EQ(lines(c_dir / "series.csv"), lines(a_dir / "series.csv"));
+  expect_resume_is_bitwise(s, [](const ParticleStore<2>& st) {
+    std::size_t merged = 0;
+    for (std::size_t i = 0; i < st.size(); ++i)
+      merged += st.origin[i] == Origin::merge || st.origin[i] == Origin::fresh_merge;
+    EXPECT_GT(merged, 0u) << "no family merged: the test would not see the merge's state";
+  });
 }
 
 // The same with per-level time steps (time.stepping = "per_level") and two levels of refinement in a zone: a
 // checkpoint is written between steps, where every bin is synchronised, and holds the rates (a, drho, kick) the
 // next step opens with.
 TEST(Runner, ResumedRunWithPerLevelStepsIsBitwiseIdenticalToTheUninterruptedOne) {
-  TempFolder tmp;
   scene::Scene s = tiny_scene();
   scene::Refinement r;
   r.criterion = scene::Criterion::zone;
@@ -187,21 +195,11 @@ TEST(Runner, ResumedRunWithPerLevelStepsIsBitwiseIdenticalToTheUninterruptedOne)
   s.effects.refinement = r;
   s.time.stepping = TimeStepping::per_level;
   s.time.end = test::short_runs() ? 0.1 : 0.15;  // shorter under the sanitizer preset (the checkpoint is at 0.05)
-  const fs::path a_dir = tmp.path() / "a", c_dir = tmp.path() / "c";
-  scene::Runner a(s, scene::RunOptions{a_dir, std::nullopt, 0.05});
-  a.start();
-  while (!fs::exists(io::RunFiles{a_dir}.checkpoint())) a.advance();
-  fs::copy(a_dir, c_dir, fs::copy_options::recursive);
-  a.run();
-  int finest = 0;
-  const auto& st = a.simulation().store();
-  for (std::size_t i = 0; i < st.size(); ++i) finest = std::max(finest, static_cast<int>(st.level[i]));
-  EXPECT_EQ(finest, 2) << "the zone should hold level-2 particles, stepping in their own bin";
-  scene::Runner c(s, scene::RunOptions{c_dir, c_dir / "checkpoint.h5", 0.05});
-  c.run();
-  EXPECT_EQ(c.simulation().step_count(), a.simulation().step_count());
-  expect_bitwise_equal(c.simulation().store(), a.simulation().store());
-  EXPECT_EQ(lines(c_dir / "series.csv"), lines(a_dir / "series.csv"));
+  expect_resume_is_bitwise(s, [](const ParticleStore<2>& st) {
+    int finest = 0;
+    for (std::size_t i = 0; i < st.size(); ++i) finest = std::max(finest, static_cast<int>(st.level[i]));
+    EXPECT_EQ(finest, 2) << "the zone should hold level-2 particles, stepping in their own bin";
+  });
 }
 
 // A finished run extended with a later time.end (--resume --set time.end=...) is the run that went to the
