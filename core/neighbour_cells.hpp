@@ -1,5 +1,5 @@
 #pragma once
-// The cell size of the neighbour grid, in one place for the step (Simulation::prepare_neighbours) and for
+// The cell size and layers of the neighbour grid, in one place for the step (Simulation::prepare_neighbours) and for
 // the queries between steps (refinement's NeighbourQuery).
 //
 // Which particles count: the fluid ones. Ghosts carry their source's h (and the store may still hold the
@@ -14,36 +14,74 @@
 // step, dam-break block with walls, one thread, 1e5 / 1e6 particles: cells of 0.5 h_min 41.2 / 418 ms,
 // h_min 26.5 / 262 ms, 2 h_min 28.0 / 272 ms; instructions over the paper's dam break (callgrind) favour
 // h_min over 2 h_min by 5-7 %, fully refined and dynamic alike.
+//
+// Levels (issue #16): with refined particles present, the grid holds one layer per level (core/cell_grid.hpp),
+// each with cells of its own finest h and a reach of its own largest h. A particle scans each layer only as
+// far as a neighbour of that layer can be: a fine particle scans the fine layer within h_i + h_fine, not
+// h_i + h_coarse, and the coarse layer's cells are as large as in a coarse-only run.
 #include <algorithm>
+#include <array>
+#include <cstdint>
 #include <cstddef>
 #include <limits>
 
+#include "core/cell_grid.hpp"
 #include "core/particle_store.hpp"
 #include "core/types.hpp"
 #include "parallel/parallel_for.hpp"
 
 namespace sph {
 
-/// Cell edge over the finest smoothing length present.
+/// Cell edge over the finest smoothing length present (in each layer of the grid, that layer's finest).
 inline constexpr double kCellPerFinestH = 1.0;
 
-/// The smallest and largest h of the fluid particles.
+/// The grid layer of a refinement level: its own up to kGridLayers - 2, then one for every deeper level.
+inline int grid_layer(std::int32_t level) {
+  return level <= 0 ? 0 : (level < kGridLayers - 1 ? static_cast<int>(level) : kGridLayers - 1);
+}
+
+/// The smallest and largest h of the fluid particles, overall and per grid layer.
 struct SmoothingRange {
-  double min = std::numeric_limits<double>::infinity();
+  static constexpr double kInf = std::numeric_limits<double>::infinity();
+  double min = kInf;
   double max = 0.0;
+  std::array<double, kGridLayers> layer_min{kInf, kInf, kInf, kInf};
+  std::array<double, kGridLayers> layer_max{};
   bool empty() const { return !(min <= max); }
-  /// One particle's contribution.
-  static SmoothingRange of(Kind kind, double h) { return kind == Kind::fluid ? SmoothingRange{h, h} : SmoothingRange{}; }
+  /// Layers up to the deepest that holds fluid (at least one).
+  int layers() const {
+    int n = 1;
+    for (int l = 0; l < kGridLayers; ++l)
+      if (layer_min[static_cast<std::size_t>(l)] <= layer_max[static_cast<std::size_t>(l)]) n = l + 1;
+    return n;
+  }
+  /// Folds in one particle.
+  void add(Kind kind, double h, std::int32_t level) {
+    if (kind != Kind::fluid) return;
+    min = std::min(min, h);
+    max = std::max(max, h);
+    const auto l = static_cast<std::size_t>(grid_layer(level));
+    layer_min[l] = std::min(layer_min[l], h);
+    layer_max[l] = std::max(layer_max[l], h);
+  }
   SmoothingRange merged(const SmoothingRange& o) const {
-    return SmoothingRange{std::min(min, o.min), std::max(max, o.max)};
+    SmoothingRange r;
+    r.min = std::min(min, o.min);
+    r.max = std::max(max, o.max);
+    for (std::size_t l = 0; l < layer_min.size(); ++l) {
+      r.layer_min[l] = std::min(layer_min[l], o.layer_min[l]);
+      r.layer_max[l] = std::max(layer_max[l], o.layer_max[l]);
+    }
+    return r;
   }
 };
 
 /// The range over a whole store (one parallel reduction).
 template <int D>
 SmoothingRange smoothing_range(const ParticleStore<D>& store) {
-  return par::reduce(
-      store.size(), SmoothingRange{}, [&](std::size_t i) { return SmoothingRange::of(store.kind[i], store.h[i]); },
+  return par::accumulate(
+      store.size(), SmoothingRange{},
+      [&](SmoothingRange& r, std::size_t i) { r.add(store.kind[i], store.h[i], store.level[i]); },
       [](const SmoothingRange& a, const SmoothingRange& b) { return a.merged(b); });
 }
 
@@ -52,6 +90,34 @@ SmoothingRange smoothing_range(const ParticleStore<D>& store) {
 inline double neighbour_cell_size(const SmoothingRange& r) {
   if (r.empty() || !(r.min > 0.0)) return 1.0;
   return kCellPerFinestH * r.min;
+}
+
+/// The bounding boxes of the grid's layers, reduced with the particles' layers.
+template <int D>
+using LayerBoxes = std::array<typename CellGrid<D>::Box, kGridLayers>;
+
+template <int D>
+LayerBoxes<D> merged(const LayerBoxes<D>& a, const LayerBoxes<D>& b) {
+  LayerBoxes<D> r;
+  for (std::size_t l = 0; l < r.size(); ++l) r[l] = a[l].merged(b[l]);
+  return r;
+}
+
+/// The layers of the neighbour grid for a range and the layers' boxes: layer l holds refinement level l (the
+/// last one the deeper levels too); its cells are sized by its own finest fluid h (a layer without fluid, such
+/// as walls alone, by the finest overall) and its queries reach h_i + its largest h. Returns the layer count.
+template <int D>
+int neighbour_layers(const SmoothingRange& r, const LayerBoxes<D>& boxes,
+                     std::array<typename CellGrid<D>::LayerSpec, kGridLayers>& spec) {
+  const int count = r.layers();
+  for (int l = 0; l < count; ++l) {
+    const auto k = static_cast<std::size_t>(l);
+    const bool fluid = r.layer_min[k] <= r.layer_max[k] && r.layer_min[k] > 0.0;
+    spec[k].box = boxes[k];
+    spec[k].cell_size = fluid ? kCellPerFinestH * r.layer_min[k] : neighbour_cell_size(r);
+    spec[k].max_h = r.layer_max[k];
+  }
+  return count;
 }
 
 }  // namespace sph

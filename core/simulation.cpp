@@ -28,11 +28,11 @@ std::uint32_t Simulation::output_count(const ParticleView<2>& view, std::size_t 
 void Simulation::prepare_neighbours() {
   const auto view = store_.view();
   expand_offsets_.resize(view.n + 1);
-  const SmoothingRange hr = par::reduce(
+  const SmoothingRange hr = par::accumulate(
       view.n, SmoothingRange{},
-      [&](std::size_t i) {
+      [&](SmoothingRange& r, std::size_t i) {
         expand_offsets_[i] = output_count(view, i);
-        return SmoothingRange::of(view.kind[i], view.h[i]);
+        r.add(view.kind[i], view.h[i], view.level[i]);
       },
       [](const SmoothingRange& a, const SmoothingRange& b) { return a.merged(b); });
   build_neighbours(hr);
@@ -49,31 +49,41 @@ void Simulation::build_neighbours(const SmoothingRange& hr) {
   expand_src_.resize(m);
   expand_image_.resize(m);
   expand_x_.resize(m);
+  expand_layer_.resize(m);
+  // Each particle's grid layer is its level's (ghosts take their source's); levels beyond the deepest with
+  // fluid cannot occur among the sources, which are fluid or walls (level 0).
+  const int layers = hr.layers();
   using Box = CellGrid<2>::Box;
-  const Box box = par::reduce(
-      n, Box{},
-      [&](std::size_t i) {
+  using Boxes = LayerBoxes<2>;
+  const Boxes boxes = par::accumulate(
+      n, Boxes{},
+      [&](Boxes& b, std::size_t i) {
         const std::uint32_t first = expand_offsets_[i], count = expand_offsets_[i + 1] - first;
-        Box b;
-        if (count == 0) return b;
+        if (count == 0) return;
+        const auto layer = static_cast<std::uint8_t>(std::min(grid_layer(view.level[i]), layers - 1));
+        Box& box = b[layer];
         expand_src_[first] = static_cast<std::uint32_t>(i);
         expand_image_[first] = -1;
         expand_x_[first] = view.x[i];
-        b = Box::of(view.x[i]);
-        if (count == 1) return b;
+        expand_layer_[first] = layer;
+        box = box.merged(Box::of(view.x[i]));
+        if (count == 1) return;
         const GhostBuilder::Images im = ghosts_->images(view.x[i], view.v[i], view.h[i]);
         for (std::uint32_t g = 1; g < count; ++g) {
           expand_src_[first + g] = static_cast<std::uint32_t>(i);
           expand_image_[first + g] = static_cast<std::int8_t>(g - 1);
           expand_x_[first + g] = im.x[g - 1];
-          b = b.merged(Box::of(im.x[g - 1]));
+          expand_layer_[first + g] = layer;
+          box = box.merged(Box::of(im.x[g - 1]));
         }
-        return b;
       },
-      [](const Box& a, const Box& b) { return a.merged(b); });
-  // The cell sort of the expanded set, composed with the expansion into one source map. Cells sized by the
-  // finest support present (core/neighbour_cells.hpp); each particle's query reaches h_i + h_max.
-  grid_.build_in(box, expand_x_.data(), m, neighbour_cell_size(hr), hr.max);
+      [](const Boxes& a, const Boxes& b) { return merged<2>(a, b); });
+  // The cell sort of the expanded set, composed with the expansion into one source map: one layer per level
+  // present, each with cells sized by its finest support and queries reaching h_i + its largest h
+  // (core/neighbour_cells.hpp).
+  std::array<CellGrid<2>::LayerSpec, kGridLayers> spec;
+  neighbour_layers<2>(hr, boxes, spec);
+  grid_.build_layers(spec.data(), layers, expand_x_.data(), layers > 1 ? expand_layer_.data() : nullptr, m);
   const std::uint32_t* order = grid_.order().data();
   const std::uint32_t* src = expand_src_.data();
   // One gather of every field, then the copies that are ghosts become ghosts.
@@ -163,9 +173,9 @@ StepInfo Simulation::step(double dt_cap) {
     {
       auto s = store_.view();
       expand_offsets_.resize(s.n + 1);
-      hr = par::reduce(
+      hr = par::accumulate(
           s.n, SmoothingRange{},
-          [&](std::size_t i) {
+          [&](SmoothingRange& r, std::size_t i) {
             if (k == 1 && watch) last_good_.copy_particle(store_, i);
             if (s.kind[i] == Kind::fluid) {
               if (k == 1) {
@@ -176,7 +186,7 @@ StepInfo Simulation::step(double dt_cap) {
               integ.drift(s, i, tau, k, finest);
             }
             expand_offsets_[i] = output_count(s, i);
-            return SmoothingRange::of(s.kind[i], s.h[i]);
+            r.add(s.kind[i], s.h[i], s.level[i]);
           },
           [](const SmoothingRange& a, const SmoothingRange& b) { return a.merged(b); });
     }

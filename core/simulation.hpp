@@ -150,6 +150,7 @@ class Simulation {
   std::vector<std::uint32_t> expand_src_, expand_offsets_;
   std::vector<std::uint32_t> due_prefix_;  // Activity::due_prefix of the current substep
   std::vector<std::int8_t> expand_image_;
+  std::vector<std::uint8_t> expand_layer_;  // each expanded particle's grid layer (its source's level)
   std::vector<Vec<2>> expand_x_;  // the state before the current step (watchdog rollback)
   Work work_;
   double time_ = 0.0;

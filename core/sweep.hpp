@@ -95,8 +95,11 @@ class PairSweep {
           const double hi = s.h[i];
           const double inv_hi = 1.0 / hi;
           pr.p_rho2_i = s.p[i] / (s.rho[i] * s.rho[i]);
-          grid.for_each_candidate_run(xi, hi + grid.max_h(), [&](std::uint32_t b, std::uint32_t e) {
-            if (!due && act.due_prefix != nullptr && act.due_prefix[e] == act.due_prefix[b]) return;
+          // A particle that is not due only meets due ones: it skips a layer (a level) or a run without any.
+          const bool all = due || act.due_prefix == nullptr;
+          const auto holds_due = [&](std::uint32_t b, std::uint32_t e) { return all || act.due_prefix[e] != act.due_prefix[b]; };
+          grid.for_each_support_run(xi, hi, [&](std::uint32_t b, std::uint32_t e) {
+            if (!holds_due(b, e)) return;
             candidates += e - b;
             for (std::uint32_t j = b; j < e; ++j) {
               const Vec<D> xij = xi - s.x[j];
@@ -132,7 +135,7 @@ class PairSweep {
               std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, fluid_);
               mu_max = std::max(mu_max, std::abs(pr.mu));
             }
-          });
+          }, holds_due);
           lim.pairs = pairs;
           lim.candidates = candidates;
           if (!due) {  // only the pairs with a due partner: their impulses, no rates, no limits

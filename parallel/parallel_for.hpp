@@ -60,6 +60,26 @@ T reduce(std::size_t n, T identity, Map&& map, Combine&& combine) {
   return result;
 }
 
+/// reduce() for a large accumulator (an array of boxes, say) that each item updates in place rather than
+/// combines whole: update(acc, i) folds item i into its chunk's acc, in index order; the chunks' results are
+/// combined in chunk order. Identical at any thread count.
+template <class T, class Update, class Combine>
+T accumulate(std::size_t n, T identity, Update&& update, Combine&& combine) {
+  const std::size_t chunks = chunk_count(n);
+  thread_local std::vector<T> buffer;  // as in reduce
+  std::vector<T>& partial = buffer;
+  partial.assign(chunks, identity);
+  parallel_for_dynamic(chunks, 1, [&](std::size_t c) {
+    T acc = identity;
+    const std::size_t end = std::min(n, (c + 1) * kChunk);
+    for (std::size_t i = c * kChunk; i < end; ++i) update(acc, i);
+    partial[c] = acc;
+  });
+  T result = identity;
+  for (const T& p : partial) result = combine(result, p);
+  return result;
+}
+
 /// Deterministic parallel sum of map(i).
 template <class T, class Map>
 T sum(std::size_t n, T zero, Map&& map) {

@@ -19,6 +19,7 @@
 #include "core/cell_grid.hpp"
 #include "core/types.hpp"
 #include "tests/support/brute_force.hpp"
+#include "tests/support/test_scale.hpp"
 
 namespace sph {
 namespace {
@@ -26,12 +27,8 @@ namespace {
 using NeighbourLists = std::vector<std::vector<std::uint32_t>>;
 
 /// SPH_TEST_SCALE=short (the asan preset) shrinks the brute-force comparisons.
-bool short_scale() {
-  const char* s = std::getenv("SPH_TEST_SCALE");
-  return s != nullptr && std::string(s) == "short";
-}
 std::size_t scaled(std::size_t n) {
-  return short_scale() ? std::max<std::size_t>(n / 4, 1) : n;
+  return test::short_runs() ? std::max<std::size_t>(n / 4, 1) : n;
 }
 
 /// Restores the OpenMP thread count on scope exit.
