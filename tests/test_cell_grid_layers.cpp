@@ -15,7 +15,6 @@
 #include "core/neighbour_cells.hpp"
 #include "core/types.hpp"
 #include "tests/support/brute_force.hpp"
-#include "tests/support/test_scale.hpp"
 
 namespace sph {
 namespace {
@@ -143,37 +142,35 @@ void expect_equal_to_brute_force(const Cloud<D>& c, int expected_layers) {
   EXPECT_GT(test::pair_count(expected), c.x.size()) << "the layout should produce pairs to compare";
 }
 
-int side(int full) { return test::short_runs() ? full / 2 : full; }
-
 TEST(CellGridLayers, NeighboursEqualBruteForceWithTwoLevels) {
-  expect_equal_to_brute_force(refined_block<2>(side(24), {1}, 1), 2);
+  expect_equal_to_brute_force(refined_block<2>(24, {1}, 1), 2);
 }
 
 TEST(CellGridLayers, NeighboursEqualBruteForceWithThreeLevels) {
-  expect_equal_to_brute_force(refined_block<2>(side(24), {1, 2}, 2), 3);
+  expect_equal_to_brute_force(refined_block<2>(24, {1, 2}, 2), 3);
 }
 
 TEST(CellGridLayers, NeighboursEqualBruteForceWithAnEmptyMiddleLayer) {
   // Levels 0 and 2 only: layer 1 has no particle and is skipped by every query.
-  expect_equal_to_brute_force(refined_block<2>(side(24), {2}, 3), 3);
+  expect_equal_to_brute_force(refined_block<2>(24, {2}, 3), 3);
 }
 
 TEST(CellGridLayers, LevelsDeeperThanTheLayersShareTheLast) {
   // Levels 1, 2, 3 and 4: levels 3 and 4 share the last layer, whose reach is its largest h (level 3's).
-  const Cloud<2> c = refined_block<2>(side(24), {1, 2, 3, 4}, 4);
+  const Cloud<2> c = refined_block<2>(24, {1, 2, 3, 4}, 4);
   ASSERT_GT(std::count(c.level.begin(), c.level.end(), 4), 0);
   expect_equal_to_brute_force(c, kGridLayers);
 }
 
 TEST(CellGridLayers, NeighboursEqualBruteForceWithTwoLevels3D) {
-  expect_equal_to_brute_force(refined_block<3>(side(10), {1}, 5), 2);
+  expect_equal_to_brute_force(refined_block<3>(10, {1}, 5), 2);
 }
 
 TEST(CellGridLayers, ACandidateCheckIsOnlyWhereTheParticlesOwnSupportInThatLayerCanReach) {
   // Every candidate a query checks lies in a cell overlapping the square [x_i - R_l, x_i + R_l]^D, R_l = h_i +
   // max_h(l), so within R_l plus one of the layer's cells of x_i (the bound below counts those particles, by
   // brute force).
-  const Cloud<2> c = refined_block<2>(side(24), {1}, 6);
+  const Cloud<2> c = refined_block<2>(24, {1}, 6);
   const LayeredGrid<2> layered(c);
   const LayeredGrid<2> single(c, true);
   const std::vector<std::size_t> got = layered.candidates(), one = single.candidates();

@@ -31,7 +31,7 @@ struct Candidate {
 struct FamilyOutcome {
   std::array<std::uint32_t, 4> members{};  // store indices in sibling order
   std::uint32_t keeper = 0;                // the lowest store index: the merged particle goes there
-  int verdict = 0;                         // 0 merged, 1 off walls, 2 would split again
+  int verdict = 0;                         // 0 merged, 1 off walls, 2 would split again, 3 dispersed
   double d_kinetic = 0.0, d_angular = 0.0;
   // The merged state.
   Vec<2> x = Vec<2>::Zero(), v = Vec<2>::Zero(), vh = Vec<2>::Zero();
@@ -91,7 +91,16 @@ MergeResult merge_families(ParticleStore<2>& store, const std::vector<std::uint8
     f.rho = m / vol;
     f.rhoh = m / volh;
     const double d_merged = 2.0 * store.d[f.members[0]];
-    if (!clear_of_walls(f.x, geometry, walls, 0.125 * d_merged)) {
+    // The merged particle stands for the square of side d_merged centred on it: a member outside that square
+    // has drifted into another particle's place, and the merged particle would land among other particles.
+    double spread = 0.0;
+    for (const std::uint32_t i : f.members) spread = std::max(spread, (store.x[i] - f.x).cwiseAbs().maxCoeff());
+    // It must also sit as far from a wall as the set-up puts a particle of its spacing, d_merged / 2 (less
+    // rounding: a family split from such a particle merges back), where the Lennard-Jones wall force of a
+    // particle of that spacing (r0 = d / 2 by default) starts; closer, it would start inside that force's range.
+    if (spread > 0.5 * d_merged) {
+      f.verdict = 3;
+    } else if (!clear_of_walls(f.x, geometry, walls, 0.5 * d_merged * (1.0 - 1e-12))) {
       f.verdict = 1;
     } else if (would_split && would_split(f.x, f.v)) {
       f.verdict = 2;
@@ -108,6 +117,10 @@ MergeResult merge_families(ParticleStore<2>& store, const std::vector<std::uint8
     }
     if (f.verdict == 2) {
       ++result.kept_by_criterion;
+      continue;
+    }
+    if (f.verdict == 3) {
+      ++result.kept_dispersed;
       continue;
     }
     ++result.merged;

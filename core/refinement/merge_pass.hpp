@@ -24,13 +24,16 @@ struct MergeResult {
   std::size_t merged = 0;            // families merged (each four particles into one)
   std::size_t kept_off_walls = 0;    // complete families left alone: their centre of mass was too close to a wall
   std::size_t kept_by_criterion = 0; // complete families left alone: the merged particle would be split again
+  std::size_t kept_dispersed = 0;    // complete families left alone: a member is outside the merged particle's square
   double d_kinetic = 0.0;            // kinetic energy after - before (J/m), <= 0
   double d_angular = 0.0;            // angular momentum L_z after - before (kg m^2/s per m)
 };
 
 /// Merges every family whose four members are fluid and have may_merge[i] != 0 (may_merge has store.size()
-/// entries). A family is left alone when its centre of mass is outside the fluid domain or closer to a wall
-/// than an eighth of the merged spacing (the split pass's margin for the family's daughters), or when
+/// entries). A family is left alone when a member lies outside the square of side d (the merged spacing)
+/// centred on the family's centre of mass (the family has dispersed: the merged particle would land among
+/// others), when that centre is outside the fluid domain or closer to a wall than d / 2 (where the set-up
+/// puts a particle of spacing d, and where the Lennard-Jones wall force of such a particle begins), or when
 /// `would_split(X, V)` says the merged particle would be marked for a split at once. `time` is written as
 /// the merged particle's level_time.
 MergeResult merge_families(ParticleStore<2>& store, const std::vector<std::uint8_t>& may_merge,
