@@ -431,22 +431,24 @@ def findings_section(f):
         if all(study):
             maxes = [r["max_dZ"] for r in study]
             sh = study[-1]["shift"]
-            peer = [r["max_dZ_peer"] for r in study]
-            out.append("- Martin & Moyce 2:1 column, fully refined at d = a/30, a/60, a/120: largest |Z - Z_exp| = "
-                       + ", ".join(f"{m:.3f}" for m in maxes) + f" with the fitted time origin ({sh:.3f}; target "
-                       f"0.1: {'met' if maxes[-1] <= 0.1 and maxes[-2] <= 0.1 else 'not met'} at the two finest "
-                       f"resolutions{'' if maxes[0] <= 0.1 else ', not at a/30'}); with the peers' 0.175 it is "
-                       + ", ".join(f"{m:.3f}" for m in peer) + " (at T = "
-                       + ", ".join(f"{r['worst_T_peer']:.2f}" for r in study) + "). "
-                       "The shift is one free parameter fitted to the same 15 points it is judged on; what it cannot "
-                       "absorb is the shape: the simulated front leaves the column later than the measured one "
-                       f"(at the first point, T = {study[-1]['T_exp'][0]:.2f}, the finest run is {study[-1]['first_dZ']:+.3f} from the measurement "
-                       "with this shift) and does not "
-                       "slow down at the end as the measured front does (last interval dZ/dT = "
+            heights = [r["max_dH"] for r in study]
+            falls = maxes[2] < maxes[1] < maxes[0]
+            out.append("- Martin & Moyce 2:1 column, fully refined at d = a/30, a/60, a/120, with one time origin for "
+                       f"front and height (the peers' {sh:.3f}, not fitted here): largest |Z - Z_exp| = "
+                       + ", ".join(f"{m:.3f}" for m in maxes) + " (at T = "
+                       + ", ".join(f"{r['worst_T']:.2f}" for r in study) + f"; target 0.1: "
+                       f"{'met' if maxes[-1] <= 0.1 and maxes[-2] <= 0.1 else 'not met'}), largest |H/H0 - Table 6| = "
+                       + ", ".join(f"{m:.3f}" for m in heights) + ". The front's error "
+                       + ("falls" if falls else "does not fall") + " as the resolution rises. "
+                       f"A shift fitted to the finest run's front ({study[-1]['fitted']:.3f}) would bring its front "
+                       f"to {study[-1]['max_dZ_fit']:.3f}, but it is fitted to the points it would be judged on. What no "
+                       "shift absorbs is the shape: the simulated front leaves the column later than the measured one "
+                       f"(at the first point, T = {study[-1]['T_exp'][0]:.2f}, the finest run is {study[-1]['first_dZ']:+.3f} "
+                       "from the measurement) and does not slow down at the end as the measured front does (last "
+                       "interval dZ/dT = "
                        f"{(study[-1]['z_exp'][-1] - study[-1]['z_exp'][-2]) / (study[-1]['T_exp'][-1] - study[-1]['T_exp'][-2]):.2f}"
-                       " measured). The "
-                       "walls are free-slip and the model inviscid but for the artificial viscosity; the "
-                       "experiment's thin front is slowed by the floor's and the side walls' friction, which a 2D "
+                       " measured). The walls are free-slip and the model inviscid but for the artificial viscosity; "
+                       "the experiment's thin front is slowed by the floor's and the side walls' friction, which a 2D "
                        "inviscid model converging with resolution does not have.")
         if all(study):
             # Self-convergence on the tabulated times: successive differences between resolutions, the observed
@@ -472,8 +474,8 @@ def findings_section(f):
         if ns and study[1]:
             out.append(f"- With no-slip ghost walls (the same run at d = a/60) the front is slower: its best time "
                        f"origin is {ns['own_shift']:.3f} (free-slip {study[1]['own_shift']:.3f}), and with the peers' "
-                       f"0.175 its largest |Z - Z_exp| is {ns['max_dZ_peer']:.3f} (free-slip "
-                       f"{study[1]['max_dZ_peer']:.3f}). But with the artificial viscosity as the only viscous term "
+                       f"0.175 its largest |Z - Z_exp| is {ns['max_dZ']:.3f} (free-slip "
+                       f"{study[1]['max_dZ']:.3f}). But with the artificial viscosity as the only viscous term "
                        "the wall friction is far stronger than water's at the experiment's Reynolds number: the "
                        f"no-slip wall holds water at the back wall, so the residual height there departs from Table 6 "
                        f"by up to {ns['max_dH']:.3f} H0 (free-slip: {study[1]['max_dH']:.3f} H0).")
@@ -717,9 +719,10 @@ def main():
             inside = Te <= Ts[-1]
             return np.interp(Te[inside], Ts, s["Z"] / a) - Ze[inside], inside
 
-        # The experiment's time origin is not known (the column's release), so it is fitted once: the shift that
-        # minimises the RMS of Z - Z_exp for the finest fully refined run (the converged model), then used for
-        # every variant. The peers' 0.175 is reported alongside.
+        # The experiment's time origin is not known (the column's release). One origin serves the front and the
+        # residual height alike: the peers' 0.175 (in T = t sqrt(2g/a)), taken from them, not fitted here. The shift
+        # that would minimise the finest run's front error is computed only as a diagnostic: fitted to the same
+        # 15 points, it cannot be a test of them.
         peer_shift = 0.175
         grid = np.arange(0.0, 0.5001, 0.005)
 
@@ -728,43 +731,46 @@ def main():
 
         finest = next((n for n in ("refined_a60", "refined", "refined_a15") if n in R), None)
         shift = peer_shift
-        if finest:
-            shift = own_shift(R[finest]["series"])
+        fitted = own_shift(R[finest]["series"]) if finest else float("nan")
         release_ms = 1000 * shift / math.sqrt(2 * G / 0.05715)
         fig, axes = plt.subplots(1, 2, figsize=(11, 4))
         md.append("## Martin & Moyce's 2:1 column (direct comparison with the experiment)\n")
-        md.append(f"The experiment's time origin is uncertain (the column's release), so simulated T = t sqrt(2g/a) "
-                  f"is shifted: by {shift:.3f}, the shift that minimises the RMS of Z - Z_exp over the 15 tabulated "
-                  f"times for the finest fully refined run ({finest}), fitted once and used for every variant "
-                  f"(at the experiment's a = 2.25 in that is {release_ms:.0f} ms). Peers shift by about "
-                  f"{peer_shift}; the table gives the largest difference with that shift too.\n")
+        md.append(f"The experiment's time origin is uncertain (the column's release). One origin serves the surge "
+                  f"front and the residual height: the simulated time is shifted by the peers' {shift:.3f} in "
+                  f"T = t sqrt(2g/a) ({shift / math.sqrt(2):.3f} in tau = t sqrt(g/a); at the experiment's a = 2.25 in, "
+                  f"{release_ms:.0f} ms), taken from them and not fitted here. The shift that would minimise the "
+                  f"finest run's front error, {fitted:.3f}, is given as a diagnostic only: fitted to the same 15 points, "
+                  "it cannot test them. The height is also given with no shift.\n")
         rows = []
         for name, r in sorted(R.items()):
             s = r["series"]
             Ts = s["time"] * math.sqrt(2 * G / a) + shift
             Zs = s["Z"] / a
             dz, inside = front_diff(s, shift)
-            dz_peer, _ = front_diff(s, peer_shift)
-            tau = s["time"] * math.sqrt(G / a)
+            dz_fit, _ = front_diff(s, fitted)
             th, hh = mm_h["tau_t_sqrt_g_over_a"], mm_h["H_star_h_over_H0"]
-            within = th <= tau[-1]
-            dh = np.interp(th[within], tau, s["H"] / (2 * a)) - hh[within]
+
+            def height_diff(tau_shift):
+                tau = s["time"] * math.sqrt(G / a) + tau_shift
+                within = th <= tau[-1]
+                dh = np.interp(th[within], tau, s["H"] / (2 * a)) - hh[within]
+                return float(np.max(np.abs(dh))) if within.any() else float("nan")
+
             rows.append({"name": name, "wall": r["summary"]["wall_seconds"], "steps": r["summary"]["step"],
                          "max_dZ": float(np.max(np.abs(dz))), "rms_dZ": float(np.sqrt(np.mean(dz ** 2))),
-                         "max_dZ_peer": float(np.max(np.abs(dz_peer))), "shift": shift,
+                         "max_dZ_fit": float(np.max(np.abs(dz_fit))), "shift": shift, "fitted": fitted,
                          "own_shift": own_shift(s), "first_dZ": float(dz[0]),
-                         "worst_T_peer": float(Te[inside][np.argmax(np.abs(dz_peer))]),
                          "worst_T": float(Te[inside][np.argmax(np.abs(dz))]),
                          "z_exp_times": np.where(inside, np.interp(Te, Ts, Zs), np.nan), "z_exp": Ze, "T_exp": Te,
-                         "max_dH": float(np.max(np.abs(dh))) if within.any() else float("nan"),
+                         "max_dH": height_diff(shift / math.sqrt(2)), "max_dH_noshift": height_diff(0.0),
                          "n": int(s["fluid"][-1])})
             axes[0].plot(Ts, Zs, label=name)
-            axes[1].plot(s["time"] * math.sqrt(G / a), s["H"] / (2 * a), label=name)
+            axes[1].plot(s["time"] * math.sqrt(G / a) + shift / math.sqrt(2), s["H"] / (2 * a), label=name)
         axes[0].plot(Te, Ze, "ko", ms=4, label="Martin & Moyce Table 2")
         axes[1].plot(mm_h["tau_t_sqrt_g_over_a"], mm_h["H_star_h_over_H0"], "ko", ms=4, label="Table 6")
         axes[0].set_xlabel(f"T = t sqrt(2g/a) (simulated + {shift:.3f})")
         axes[0].set_ylabel("Z = z / a")
-        axes[1].set_xlabel("tau = t sqrt(g/a)")
+        axes[1].set_xlabel(f"tau = t sqrt(g/a) (simulated + {shift / math.sqrt(2):.3f})")
         axes[1].set_ylabel("H / H0")
         for ax in axes:
             ax.grid(alpha=0.3)
@@ -775,10 +781,11 @@ def main():
         md.append("![MM](figures/validation_mm_column.png)\n")
         md.append(table(rows, [("variant", lambda r: r["name"]), ("particles", lambda r: r["n"]),
                                ("wall s", lambda r: r["wall"]), ("steps", lambda r: r["steps"]),
-                               ("max abs(Z - Z_exp)", lambda r: r["max_dZ"]),
+                               (f"max abs(Z - Z_exp), shift {shift}", lambda r: r["max_dZ"]),
                                ("RMS Z - Z_exp", lambda r: r["rms_dZ"]),
-                               (f"max abs(Z - Z_exp), shift {peer_shift}", lambda r: r["max_dZ_peer"]),
-                               ("max abs(H/H0 - Table 6)", lambda r: r["max_dH"])]))
+                               (f"max abs(H/H0 - Table 6), shift {shift}", lambda r: r["max_dH"]),
+                               ("same, no shift", lambda r: r["max_dH_noshift"]),
+                               (f"max abs(Z - Z_exp), fitted {fitted:.3f} (diagnostic)", lambda r: r["max_dZ_fit"])]))
         md.append("\nVariants: refined_a15 / refined / refined_a60 are fully refined runs at d = a/30, a/60, a/120 "
                   "(the resolution study); unrefined and aap start at d = a/30.\n")
         findings["mm_column"] = rows
