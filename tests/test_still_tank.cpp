@@ -1,6 +1,6 @@
 // Still water in a tank (make_still_tank: 25 m wide, 10 m deep, ghost walls, gravity) stays still and
 // hydrostatic over 10 s of physical time, at the paper's spacing d = 25/30 m and at d/2, and with the
-// optional density diffusion.
+// optional density diffusion. The band pressures are judged by their time average over the last 5 s.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,6 +9,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "core/case_builder.hpp"
 #include "tests/support/physics_helpers.hpp"
@@ -83,6 +84,25 @@ TankState measure(const sph::Simulation& sim, const sph::TankSpec& spec) {
   return out;
 }
 
+/// The time average of a band's p / hydrostatic over the steps added (weighted by their dt), and its range.
+struct Averages {
+  double sum = 0.0, time = 0.0;
+  double lo = std::numeric_limits<double>::infinity(), hi = -std::numeric_limits<double>::infinity();
+  void add(const sph::Simulation& sim, const sph::TankSpec& spec, double y0, double dt) {
+    double p = 0.0, expected = 0.0;
+    std::size_t count = 0;
+    band(sim.store(), y0, spec.spacing, spec.width, spec.depth, sim.settings().eos.rho0, p, expected, count);
+    if (count == 0 || !(expected > 0.0)) return;
+    const double r = p / expected;
+    sum += r * dt;
+    time += dt;
+    lo = std::min(lo, r);
+    hi = std::max(hi, r);
+  }
+  double ratio() const { return sum / time; }
+  double half_range() const { return 0.5 * (hi - lo); }
+};
+
 void run_still_tank(double spacing, bool density_diffusion = false) {
   sph::TankSpec spec;
   spec.spacing = spacing;
@@ -98,10 +118,18 @@ void run_still_tank(double spacing, bool density_diffusion = false) {
   // the physics is held to the full 10 s by the release run.
   const double t_end = sph::test::short_runs() ? 2.0 : 10.0;
   double max_speed_seen = 0.0;
+  // The band pressures oscillate (the tank's compression mode: the bottom band swings by a few per cent at
+  // ~2.6 Hz, undamped), so they are judged by their time average over the second half of the run (the last
+  // 5 s, ~13 periods), each step weighted by its length; the swing's half range is reported beside it.
+  Averages mid, bottom;
   while (sim.time() < t_end * (1.0 - 1e-14)) {
-    sim.step(t_end - sim.time());
+    const sph::StepInfo info = sim.step(t_end - sim.time());
     max_speed_seen = std::max(max_speed_seen, sim.diagnostics().max_speed);
     ASSERT_TRUE(std::isfinite(sim.dt()) && sim.dt() > 0.0) << "t = " << sim.time();
+    if (sim.time() > 0.5 * t_end) {
+      mid.add(sim, spec, 0.5 * spec.depth, info.dt);
+      bottom.add(sim, spec, 0.5 * spec.spacing, info.dt);
+    }
   }
   sim.remove_ghosts();
   const TankState end = measure(sim, spec);
@@ -119,8 +147,20 @@ void run_still_tank(double spacing, bool density_diffusion = false) {
   EXPECT_LT(end.max_speed, 0.05 * wave_speed);
   ASSERT_GT(end.n_mid, 10u);
   ASSERT_GT(end.n_bottom, 10u);
-  EXPECT_NEAR(end.p_mid, end.p_mid_expected, 0.05 * end.p_mid_expected);
-  EXPECT_NEAR(end.p_bottom, end.p_bottom_expected, 0.05 * end.p_bottom_expected);
+  // Time-averaged band pressure against hydrostatic, rho0 g (depth - y). The bound is the 5 % this test held the
+  // pressure to at one instant, kept, not derived: the time averages sit about 2 % (mid-depth) and 3 % (bottom)
+  // above hydrostatic at both spacings, an offset that does not shrink with d and whose cause is open
+  // (docs/METHOD.md, "Still water across a level jump": the kernel's lattice gradient factor at h = 1.2 d accounts
+  // for 0.9 % of it). So no tighter bound can be reasoned yet; this one catches the offset growing.
+  for (const auto& [name, avg] : {std::pair{"mid-depth", &mid}, std::pair{"bottom", &bottom}}) {
+    const double tolerance = 0.05;
+    ASSERT_GT(avg->time, 0.0);
+    EXPECT_NEAR(avg->ratio(), 1.0, tolerance)
+        << name << " band: time-averaged p / hydrostatic = " << avg->ratio() << ", swing (half range) "
+        << avg->half_range() << " of hydrostatic";
+    testing::Test::RecordProperty(std::string(name) + "_p_over_hydrostatic", std::to_string(avg->ratio()));
+    testing::Test::RecordProperty(std::string(name) + "_swing", std::to_string(avg->half_range()));
+  }
   // The largest density error of still water is the floor's hydrostatic compression; noise may add at most as
   // much again.
   EXPECT_LT(end.max_density_error, 2.0 * floor_compression);
