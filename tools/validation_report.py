@@ -300,7 +300,9 @@ def pareto_section(case, label, R, d0, box, window, window_text, quick, fig_name
           "log-log interpolated between the two uniform runs that bracket it on their front (the uniform runs that no "
           "other uniform run beats in both cost and error); \">= r\" where the variant is less accurate than the "
           "cheapest uniform run (r: its cost over that run's), \"<= r\" where it is more accurate than every "
-          "uniform run on the chart.\n"]
+          "uniform run on the chart. The wall times are those of the tables (two runs side by side); a ratio of "
+          "two such times moved by 19 % between two sessions (docs/PERFORMANCE.md, \"Time steps per level\"), so "
+          "a \"x uniform, wall\" within 20 % of 1 is not a verdict; the force evaluations are deterministic.\n"]
     md.append(table(sorted(rows, key=lambda r: (not r["uniform"], r["wall"])),
                     [("variant", lambda r: r["name"]), ("finest spacing m", lambda r: r["spacing"]),
                      ("wall s", lambda r: r["wall"]), ("force evaluations", lambda r: r["evaluations"]),
