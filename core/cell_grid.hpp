@@ -137,7 +137,6 @@ class CellGrid {
       size[worst] *= 2.0;
     }
     cells_ = 0;
-    max_h_ = 0.0;
     for (int l = 0; l < count; ++l) {
       Layer& L = layers_[l];
       L = Layer{};
@@ -145,7 +144,6 @@ class CellGrid {
       L.cell_size = size[l];
       L.inv_cell = 1.0 / size[l];
       L.max_h = spec[l].max_h;
-      max_h_ = std::max(max_h_, L.max_h);
       if (empty(box[l])) continue;
       L.cells = 1;
       for (int k = 0; k < D; ++k) {
@@ -174,7 +172,11 @@ class CellGrid {
   std::size_t cell_count() const { return cells_; }
   int layer_count() const { return count_; }
   /// The largest smoothing length the grid was built for: particle i's neighbours lie within h_i + max_h().
-  double max_h() const { return max_h_; }
+  double max_h() const {
+    double m = 0.0;
+    for (int l = 0; l < count_; ++l) m = std::max(m, layers_[static_cast<std::size_t>(l)].max_h);
+    return m;
+  }
   /// The largest smoothing length of layer l's particles.
   double max_h(int l) const { return layers_[static_cast<std::size_t>(l)].max_h; }
   /// Layer l's cell edge, cell counts per axis and origin (layer 0: a grid of one layer).
@@ -187,14 +189,6 @@ class CellGrid {
   std::array<std::int64_t, D> coords(const VecD& p) const { return layers_[0].coords(p); }
   std::size_t linear(const std::array<std::int64_t, D>& c) const { return layers_[0].linear(c); }
   std::size_t cell_of(const VecD& p) const { return layers_[0].linear(layers_[0].coords(p)); }
-
-  /// Calls f(begin, end) for each contiguous run of candidate particles within `reach` of point p along
-  /// every axis, in every layer: the cells overlapping [p - reach, p + reach]^D, each row along x one run.
-  /// Runs come in a fixed order (layers, then rows in memory order).
-  template <class F>
-  void for_each_candidate_run(const VecD& p, double reach, F&& f) const {
-    for (int l = 0; l < count_; ++l) scan(layers_[static_cast<std::size_t>(l)], p, reach, f);
-  }
 
   /// The runs that can hold a neighbour of a particle at p with smoothing length h: in layer l, those within
   /// h + max_h(l). Only the layers for which keep(begin, end) holds, given the layer's particle range.
@@ -295,7 +289,6 @@ class CellGrid {
   std::size_t n_ = 0;
   std::size_t cells_ = 0;
   int count_ = 1;
-  double max_h_ = 0.5;
   std::array<Layer, kGridLayers> layers_{};
   par::CountingSortResult sorted_;
   std::vector<std::uint32_t> scratch_;

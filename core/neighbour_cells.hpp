@@ -23,6 +23,7 @@
 #include <array>
 #include <cstdint>
 #include <cstddef>
+#include <vector>
 #include <limits>
 
 #include "core/cell_grid.hpp"
@@ -35,19 +36,21 @@ namespace sph {
 /// Cell edge over the finest smoothing length present (in each layer of the grid, that layer's finest).
 inline constexpr double kCellPerFinestH = 1.0;
 
-/// The grid layer of a refinement level: its own up to kGridLayers - 2, then one for every deeper level.
-inline int grid_layer(std::int32_t level) {
-  return level <= 0 ? 0 : (level < kGridLayers - 1 ? static_cast<int>(level) : kGridLayers - 1);
+/// The grid layer of a refinement level: its own up to kGridLayers - 2, then one for every deeper level; in a
+/// grid of `count` layers, the deepest there is (the store may hold stale ghosts of a level no fluid has).
+inline int grid_layer(std::int32_t level, int count = kGridLayers) {
+  const int l = level <= 0 ? 0 : (level < kGridLayers - 1 ? static_cast<int>(level) : kGridLayers - 1);
+  return l < count ? l : count - 1;
 }
 
-/// The smallest and largest h of the fluid particles, overall and per grid layer.
+/// The smallest and largest h of the fluid particles per grid layer (and so overall).
 struct SmoothingRange {
   static constexpr double kInf = std::numeric_limits<double>::infinity();
-  double min = kInf;
-  double max = 0.0;
   std::array<double, kGridLayers> layer_min{kInf, kInf, kInf, kInf};
   std::array<double, kGridLayers> layer_max{};
-  bool empty() const { return !(min <= max); }
+  double min() const { return *std::min_element(layer_min.begin(), layer_min.end()); }
+  double max() const { return *std::max_element(layer_max.begin(), layer_max.end()); }
+  bool empty() const { return !(min() <= max()); }
   /// Layers up to the deepest that holds fluid (at least one).
   int layers() const {
     int n = 1;
@@ -58,16 +61,12 @@ struct SmoothingRange {
   /// Folds in one particle.
   void add(Kind kind, double h, std::int32_t level) {
     if (kind != Kind::fluid) return;
-    min = std::min(min, h);
-    max = std::max(max, h);
     const auto l = static_cast<std::size_t>(grid_layer(level));
     layer_min[l] = std::min(layer_min[l], h);
     layer_max[l] = std::max(layer_max[l], h);
   }
   SmoothingRange merged(const SmoothingRange& o) const {
     SmoothingRange r;
-    r.min = std::min(min, o.min);
-    r.max = std::max(max, o.max);
     for (std::size_t l = 0; l < layer_min.size(); ++l) {
       r.layer_min[l] = std::min(layer_min[l], o.layer_min[l]);
       r.layer_max[l] = std::max(layer_max[l], o.layer_max[l]);
@@ -88,8 +87,8 @@ SmoothingRange smoothing_range(const ParticleStore<D>& store) {
 /// The grid's cell size for a range: kCellPerFinestH h_min. A set without fluid searches nothing: any positive
 /// size does, and 1 m keeps the grid small.
 inline double neighbour_cell_size(const SmoothingRange& r) {
-  if (r.empty() || !(r.min > 0.0)) return 1.0;
-  return kCellPerFinestH * r.min;
+  if (r.empty() || !(r.min() > 0.0)) return 1.0;
+  return kCellPerFinestH * r.min();
 }
 
 /// The bounding boxes of the grid's layers, reduced with the particles' layers.
@@ -118,6 +117,30 @@ int neighbour_layers(const SmoothingRange& r, const LayerBoxes<D>& boxes,
     spec[k].max_h = r.layer_max[k];
   }
   return count;
+}
+
+/// The solver's layered grid over a store as it stands (not reordered): the layers of neighbour_layers(), each
+/// particle in the layer of its level (`layer` receives them). For queries between steps (refinement's
+/// NeighbourQuery) and the tests; the step builds its grid over the ghost-expanded set in the same way
+/// (Simulation::build_neighbours), reducing the boxes in its expansion loop.
+template <int D>
+void build_level_grid(const ParticleStore<D>& store, CellGrid<D>& grid, std::vector<std::uint8_t>& layer) {
+  using Box = typename CellGrid<D>::Box;
+  const SmoothingRange hr = smoothing_range(store);
+  const int layers = hr.layers();
+  const std::size_t n = store.size();
+  layer.resize(n);
+  const LayerBoxes<D> boxes = par::accumulate(
+      n, LayerBoxes<D>{},
+      [&](LayerBoxes<D>& b, std::size_t i) {
+        const auto l = static_cast<std::uint8_t>(grid_layer(store.level[i], layers));
+        layer[i] = l;
+        b[l] = b[l].merged(Box::of(store.x[i]));
+      },
+      [](const LayerBoxes<D>& a, const LayerBoxes<D>& b) { return merged<D>(a, b); });
+  std::array<typename CellGrid<D>::LayerSpec, kGridLayers> spec;
+  neighbour_layers<D>(hr, boxes, spec);
+  grid.build_layers(spec.data(), layers, store.x.data(), layer.data(), n);
 }
 
 }  // namespace sph

@@ -50,8 +50,8 @@ void Simulation::build_neighbours(const SmoothingRange& hr) {
   expand_image_.resize(m);
   expand_x_.resize(m);
   expand_layer_.resize(m);
-  // Each particle's grid layer is its level's (ghosts take their source's); levels beyond the deepest with
-  // fluid cannot occur among the sources, which are fluid or walls (level 0).
+  // Each particle's grid layer is its level's (ghosts take their source's), as in build_level_grid(); the boxes
+  // are reduced in the expansion loop, which writes the positions anyway.
   const int layers = hr.layers();
   using Box = CellGrid<2>::Box;
   using Boxes = LayerBoxes<2>;
@@ -60,7 +60,7 @@ void Simulation::build_neighbours(const SmoothingRange& hr) {
       [&](Boxes& b, std::size_t i) {
         const std::uint32_t first = expand_offsets_[i], count = expand_offsets_[i + 1] - first;
         if (count == 0) return;
-        const auto layer = static_cast<std::uint8_t>(std::min(grid_layer(view.level[i]), layers - 1));
+        const auto layer = static_cast<std::uint8_t>(grid_layer(view.level[i], layers));
         Box& box = b[layer];
         expand_src_[first] = static_cast<std::uint32_t>(i);
         expand_image_[first] = -1;

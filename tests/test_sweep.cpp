@@ -365,36 +365,46 @@ TEST(Sweep, TimeBinsEqualBruteForce) {
     fine += s.kind[i] == Kind::fluid;
   }
   ASSERT_GT(fine, 50u);
-  CellGrid<2> grid;
-  build_grid(s, grid);
   const auto sweep = sph::make_sweep(st);
-  for (const int active : {2, 1, 0}) {
-    for (const bool skip : {false, true}) {
-      SCOPED_TRACE(testing::Message() << "active bin " << active << (skip ? ", with the prefix" : ""));
-      sph::Activity act{active, sph::Integrator::kMaxBin};
-      std::vector<std::uint32_t> prefix(s.size() + 1, 0);
-      for (std::size_t i = 0; i < s.size(); ++i)
-        prefix[i + 1] = prefix[i] + (s.kind[i] != Kind::wall && act.bin(s.level[i]) >= active ? 1u : 0u);
-      if (skip) act.due_prefix = prefix.data();
-      const Vec<2> sentinel(1234.5, -6789.0);
-      for (std::size_t i = 0; i < s.size(); ++i) {
-        s.a[i] = sentinel;
-        s.drho[i] = 42.0;
-      }
-      const sph::SweepLimits lim = sweep->run(s.view(), grid, act);
-      expect_rates_match_brute_force(s, lim, st, "bins", act);
-      std::size_t kept = 0, touched = 0;
-      for (std::size_t i = 0; i < s.size(); ++i) {
-        if (s.kind[i] != Kind::fluid || s.level[i] >= active) continue;
-        EXPECT_EQ(s.a[i], sentinel) << i;
-        EXPECT_EQ(s.drho[i], 42.0) << i;
-        ++kept;
-        touched += s.kick[i] != Vec<2>::Zero();
-      }
-      if (active > 0) {
-        EXPECT_GT(kept, 50u);
-        EXPECT_GT(touched, 20u) << "coarser particles take the impulses of their due neighbours";
-        EXPECT_EQ(lim.finest_bin, 2);
+  // One grid for every level, and the solver's grid with a layer per level (whose layers without a due particle
+  // a particle that is not due skips whole).
+  for (const bool layered : {false, true}) {
+    CellGrid<2> grid;
+    if (layered) {
+      sph::test::build_level_grid_in_order(s, grid);
+      ASSERT_EQ(grid.layer_count(), 3);
+    } else {
+      build_grid(s, grid);
+    }
+    for (const int active : {2, 1, 0}) {
+      for (const bool skip : {false, true}) {
+        SCOPED_TRACE(testing::Message() << "active bin " << active << (skip ? ", with the prefix" : "")
+                                        << (layered ? ", a layer per level" : ", one grid"));
+        sph::Activity act{active, sph::Integrator::kMaxBin};
+        std::vector<std::uint32_t> prefix(s.size() + 1, 0);
+        for (std::size_t i = 0; i < s.size(); ++i)
+          prefix[i + 1] = prefix[i] + (s.kind[i] != Kind::wall && act.bin(s.level[i]) >= active ? 1u : 0u);
+        if (skip) act.due_prefix = prefix.data();
+        const Vec<2> sentinel(1234.5, -6789.0);
+        for (std::size_t i = 0; i < s.size(); ++i) {
+          s.a[i] = sentinel;
+          s.drho[i] = 42.0;
+        }
+        const sph::SweepLimits lim = sweep->run(s.view(), grid, act);
+        expect_rates_match_brute_force(s, lim, st, "bins", act);
+        std::size_t kept = 0, touched = 0;
+        for (std::size_t i = 0; i < s.size(); ++i) {
+          if (s.kind[i] != Kind::fluid || s.level[i] >= active) continue;
+          EXPECT_EQ(s.a[i], sentinel) << i;
+          EXPECT_EQ(s.drho[i], 42.0) << i;
+          ++kept;
+          touched += s.kick[i] != Vec<2>::Zero();
+        }
+        if (active > 0) {
+          EXPECT_GT(kept, 50u);
+          EXPECT_GT(touched, 20u) << "coarser particles take the impulses of their due neighbours";
+          EXPECT_EQ(lim.finest_bin, 2);
+        }
       }
     }
   }

@@ -17,22 +17,7 @@ class NeighbourQuery {
   explicit NeighbourQuery(const ParticleStore<2>& store) : store_(store) {
     // The step's cells and layers (core/neighbour_cells.hpp). The store may still hold the last step's ghosts,
     // of a level no fluid has any more: they go to the deepest layer there is (the query skips them anyway).
-    const SmoothingRange hr = smoothing_range(store);
-    const int layers = hr.layers();
-    const std::size_t n = store.size();
-    layer_.resize(n);
-    using Box = CellGrid<2>::Box;
-    const LayerBoxes<2> boxes = par::accumulate(
-        n, LayerBoxes<2>{},
-        [&](LayerBoxes<2>& b, std::size_t i) {
-          const auto l = static_cast<std::uint8_t>(std::min(grid_layer(store.level[i]), layers - 1));
-          layer_[i] = l;
-          b[l] = b[l].merged(Box::of(store.x[i]));
-        },
-        [](const LayerBoxes<2>& a, const LayerBoxes<2>& b) { return merged<2>(a, b); });
-    std::array<CellGrid<2>::LayerSpec, kGridLayers> spec;
-    neighbour_layers<2>(hr, boxes, spec);
-    grid_.build_layers(spec.data(), layers, store.x.data(), layer_.data(), n);
+    build_level_grid(store, grid_, layer_);
   }
 
   /// Calls f(j, r) for every fluid particle j != i with r_ij < 2 h_ij, in a fixed order.

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/cell_grid.hpp"
+#include "core/neighbour_cells.hpp"
 #include "core/particle_store.hpp"
 #include "core/simulation.hpp"
 #include "core/solver_settings.hpp"
@@ -77,6 +78,13 @@ inline double max_h(const ParticleStore<2>& s) {
 /// Builds the cell grid over the store and reorders the store into cell order (as the solver does).
 inline void build_grid(ParticleStore<2>& s, CellGrid<2>& grid) {
   grid.build(s.x.data(), s.size(), std::max(2.0 * max_h(s), 1e-12));
+  s.gather(grid.order());
+}
+
+/// The solver's grid with one layer per level (build_level_grid), the store reordered into its order.
+inline void build_level_grid_in_order(ParticleStore<2>& s, CellGrid<2>& grid) {
+  std::vector<std::uint8_t> layer;
+  build_level_grid(s, grid, layer);
   s.gather(grid.order());
 }
 
