@@ -18,15 +18,10 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402
 import field_error  # noqa: E402
 
-failures = []
-
-
-def check(cond, what):
-    if not cond:
-        failures.append(what)
-        print("FAIL:", what)
+check = Checks("test_field_error")
 
 
 def direct(lat, x, h, vol, v, p):
@@ -102,5 +97,4 @@ shifted = lat2.sample(xb + [0.3, 0.0], hb, vb, velocity, np.ones(len(xb)))
 e2 = field_error.errors([(0.0,) + shifted], [(0.0, phi, qv, qp)])
 check(e2["E_phi"] > 0.1, f"a block shifted by 0.3 m gives a volume-fraction error ({e2['E_phi']:.3g})")
 
-print("OK" if not failures else f"{len(failures)} failure(s)")
-sys.exit(1 if failures else 0)
+sys.exit(check.status())

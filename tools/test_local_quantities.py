@@ -19,15 +19,10 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402
 import local_quantities as lq  # noqa: E402
 
-failures = []
-
-
-def check(cond, what):
-    if not cond:
-        failures.append(what)
-        print("FAIL:", what)
+check = Checks("test_local_quantities")
 
 
 rng = np.random.default_rng(7)
@@ -78,7 +73,4 @@ err3, start3, _ = lq.probe_error(tr, run, tr, ref, t_start=3.0)
 check(start3 == 3.0 and abs(err3 - 0.3 / 2.0) < 1e-9, f"a later t_start moves the window's start ({err3})")
 check(lq.probe_error(tr, ref, tr, ref)[0] == 0.0, "a run equal to its reference has error 0")
 
-if failures:
-    print(f"{len(failures)} check(s) failed")
-    sys.exit(1)
-print("local_quantities: all checks passed")
+sys.exit(check.status())

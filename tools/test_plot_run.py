@@ -22,6 +22,7 @@ from matplotlib.figure import Figure  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+from checks import Checks  # noqa: E402
 import plot_run  # noqa: E402
 
 
@@ -52,12 +53,7 @@ def main():
         print(__doc__, file=sys.stderr)
         return 2
     exe = sys.argv[1]
-    failures = []
-
-    def check(cond, what):
-        if not cond:
-            failures.append(what)
-            print("FAIL:", what)
+    check = Checks("test_plot_run")
 
     # Record what each saved figure shows, drawn as it is saved (equal aspect applied).
     saved = {}
@@ -111,8 +107,7 @@ def main():
     finally:
         Figure.savefig = original_savefig
         shutil.rmtree(tmp, ignore_errors=True)
-    print("test_plot_run:", "FAILED" if failures else "passed", f"({len(failures)} failures)")
-    return 1 if failures else 0
+    return check.status()
 
 
 if __name__ == "__main__":

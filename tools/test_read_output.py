@@ -21,6 +21,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+from checks import Checks  # noqa: E402
 import read_output  # noqa: E402
 
 SCENE = {
@@ -66,12 +67,7 @@ def main():
         print(__doc__, file=sys.stderr)
         return 2
     exe = sys.argv[1]
-    failures = []
-
-    def check(cond, what):
-        if not cond:
-            failures.append(what)
-            print("FAIL:", what)
+    check = Checks("test_read_output")
 
     tmp = tempfile.mkdtemp(prefix="sph_test_read_output_")
     try:
@@ -168,8 +164,7 @@ def main():
         check(s["summary"]["removed_particles"] == 12, f"run.json removed {s['summary'].get('removed_particles')}")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    print("test_read_output:", "FAILED" if failures else "passed", f"({len(failures)} failures)")
-    return 1 if failures else 0
+    return check.status()
 
 
 if __name__ == "__main__":
