@@ -14,15 +14,18 @@ namespace sph {
 struct ViscositySettings {
   double alpha = 0.02;
   double beta = 0.0;
+  bool operator==(const ViscositySettings&) const = default;
 };
 
 struct ArtificialStressSettings {
   double epsilon = 0.2;  // Monaghan (2000): 0.2 with the cubic spline
   int exponent = 4;      // n in f_ij^n
+  bool operator==(const ArtificialStressSettings&) const = default;
 };
 
 struct DensityDiffusionSettings {
   double delta = 0.1;  // Molteni & Colagrossi (2009); 0.1 is the usual value
+  bool operator==(const DensityDiffusionSettings&) const = default;
 };
 
 struct LennardJonesSettings {

@@ -32,7 +32,9 @@ struct Wall2 {
 
 /// Axis-aligned rectangle [lo, hi].
 struct Box2 {
-  Vec<2> lo, hi;
+  Vec<2> lo = Vec<2>::Zero();
+  Vec<2> hi = Vec<2>::Zero();
+  bool operator==(const Box2&) const = default;
   bool contains(const Vec<2>& x) const {
     return x[0] >= lo[0] && x[0] <= hi[0] && x[1] >= lo[1] && x[1] <= hi[1];
   }

@@ -12,8 +12,9 @@
 namespace sph {
 
 struct ArtificialStress {
-  double epsilon = 0.2;
-  int exponent = 4;
+  // Built from ArtificialStressSettings (core/solver_settings.hpp), where the defaults are declared.
+  double epsilon;
+  int exponent;
 
   template <int D>
   void operator()(const ParticleView<D>& s, const Pair<D>& pr, PairSums<D>& acc) const {

@@ -7,9 +7,10 @@
 namespace sph {
 
 struct ArtificialViscosity {
-  double alpha = 0.02;
-  double beta = 0.0;
-  double c0 = 10.0;
+  // Built from ViscositySettings (core/solver_settings.hpp), where the defaults are declared, and the EOS's c0.
+  double alpha;
+  double beta;
+  double c0;
 
   template <int D>
   void operator()(const ParticleView<D>& s, const Pair<D>& pr, PairSums<D>& acc) const {

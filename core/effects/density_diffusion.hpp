@@ -14,8 +14,9 @@ namespace sph {
 
 template <int D>
 struct DensityDiffusion {
-  double delta = 0.1;
-  double c0 = 10.0;
+  // Built from DensityDiffusionSettings (core/solver_settings.hpp), where the default is declared.
+  double delta;
+  double c0;
   Vec<D> hydrostatic = Vec<D>::Zero();  // (rho0 / c0^2) g: the hydrostatic density gradient
 
   void operator()(const ParticleView<D>& s, const Pair<D>& pr, PairSums<D>& acc) const {

@@ -25,18 +25,20 @@ struct CoarseningSettings {
   double v_threshold = 5.0;  // m/s
   int min_neighbours = 16;
   double hold_time = 0.5;    // s
+  bool operator==(const CoarseningSettings&) const = default;
 };
 
 struct RefinementSettings {
   CriterionKind criterion = CriterionKind::velocity;
   double v_threshold = 10.0;  // m/s
-  Box2 zone{Vec<2>(0, 0), Vec<2>(0, 0)};
+  Box2 zone;
   int min_neighbours = 8;
   Pattern pattern = Pattern::aap;
   double rsp_k = 1.0;       // 1/2 as printed in the paper, 1 the consistent reading
   int check_interval = 100; // steps between checks
   int max_level = 1;        // daughters of level max_level are never refined
   std::optional<CoarseningSettings> coarsening;  // none: nothing ever merges
+  bool operator==(const RefinementSettings&) const = default;
 };
 
 }  // namespace sph::refine

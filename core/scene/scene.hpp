@@ -7,17 +7,16 @@
 #include <string>
 #include <vector>
 
+#include "core/boundary/ghosts.hpp"
 #include "core/boundary/wall.hpp"
+#include "core/refinement/refinement_settings.hpp"
+#include "core/solver_settings.hpp"
 #include "core/types.hpp"
 
 namespace sph::scene {
 
-/// Axis-aligned rectangle [lo, hi] (m).
-struct Rect {
-  Vec<2> lo = Vec<2>::Zero();
-  Vec<2> hi = Vec<2>::Zero();
-  bool operator==(const Rect&) const = default;
-};
+/// Axis-aligned rectangle [lo, hi] (m): the solver's box.
+using Rect = Box2;
 
 struct Container {
   Rect box;
@@ -56,24 +55,13 @@ struct Material {
   bool operator==(const Material&) const = default;
 };
 
-struct ArtificialViscosity {
-  double alpha = 0.02;
-  double beta = 0.0;
-  bool operator==(const ArtificialViscosity&) const = default;
-};
-
+// The effects' constants are the solver's own settings (core/solver_settings.hpp): one declaration of each key's
+// default, which the parser reads.
+using ArtificialViscosity = ViscositySettings;
 /// Monaghan's artificial stress (optional, off by default): a repulsion between particles under tension.
-struct ArtificialStress {
-  double epsilon = 0.2;
-  int exponent = 4;
-  bool operator==(const ArtificialStress&) const = default;
-};
-
+using ArtificialStress = ArtificialStressSettings;
 /// Density diffusion, delta-SPH with the hydrostatic correction (optional, off by default).
-struct DensityDiffusion {
-  double delta = 0.1;
-  bool operator==(const DensityDiffusion&) const = default;
-};
+using DensityDiffusion = DensityDiffusionSettings;
 
 /// Fixed wall particles with the Lennard-Jones repulsion, eq. (10). D given directly (strength) or as
 /// 5 g H from a reference height.
@@ -85,31 +73,12 @@ struct LennardJonesWall {
   bool operator==(const LennardJonesWall&) const = default;
 };
 
-enum class Slip { free_slip, no_slip };
-enum class Criterion { velocity, zone, few_neighbours };
-enum class Pattern { aap, rsp };
-
-/// Coarsening (effects.refinement.coarsening): a family of four daughters merges back into one particle
-/// when all four pass the criterion's merge test and have been at their level for hold_time.
-struct Coarsening {
-  double v_threshold = 5.0;  // velocity: merge below (the parser's default: half the split threshold)
-  int min_neighbours = 16;   // few_neighbours: merge at or above (the parser's default: twice the split count)
-  double hold_time = 0.5;    // s
-  bool operator==(const Coarsening&) const = default;
-};
-
-struct Refinement {
-  Criterion criterion = Criterion::velocity;
-  double v_threshold = 10.0;
-  Rect zone;
-  int min_neighbours = 8;
-  Pattern pattern = Pattern::aap;
-  double rsp_k = 1.0;
-  int check_interval = 100;
-  int max_level = 1;
-  std::optional<Coarsening> coarsening;
-  bool operator==(const Refinement&) const = default;
-};
+using Slip = GhostSlip;
+// Dynamic refinement and coarsening are the refinement stage's settings (core/refinement/refinement_settings.hpp).
+using Criterion = refine::CriterionKind;
+using Pattern = refine::Pattern;
+using Coarsening = refine::CoarseningSettings;
+using Refinement = refine::RefinementSettings;
 
 /// Refinement once at set-up: every fluid particle (no box) or those inside the box.
 struct StaticRefinement {

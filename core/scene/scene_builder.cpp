@@ -6,32 +6,6 @@
 
 namespace sph::scene {
 
-namespace {
-
-Box2 box(const Rect& r) { return Box2{r.lo, r.hi}; }
-
-refine::Pattern pattern(Pattern p) { return p == Pattern::aap ? refine::Pattern::aap : refine::Pattern::rsp; }
-
-refine::RefinementSettings refinement_settings(const Refinement& r) {
-  refine::RefinementSettings s;
-  switch (r.criterion) {
-    case Criterion::velocity: s.criterion = refine::CriterionKind::velocity; break;
-    case Criterion::zone: s.criterion = refine::CriterionKind::zone; break;
-    case Criterion::few_neighbours: s.criterion = refine::CriterionKind::few_neighbours; break;
-  }
-  s.v_threshold = r.v_threshold;
-  s.zone = box(r.zone);
-  s.min_neighbours = r.min_neighbours;
-  s.pattern = pattern(r.pattern);
-  s.rsp_k = r.rsp_k;
-  s.check_interval = r.check_interval;
-  s.max_level = r.max_level;
-  if (const auto& c = r.coarsening) s.coarsening = refine::CoarseningSettings{c->v_threshold, c->min_neighbours, c->hold_time};
-  return s;
-}
-
-}  // namespace
-
 SolverSettings solver_settings(const Scene& scene) {
   SolverSettings s;
   s.eos.rho0 = scene.material.rho0;
@@ -39,23 +13,19 @@ SolverSettings solver_settings(const Scene& scene) {
   s.eos.c0 = sound_speed(scene);
   const Effects& e = scene.effects;
   s.gravity = e.gravity;
-  s.viscosity.reset();
-  if (e.artificial_viscosity) s.viscosity = ViscositySettings{e.artificial_viscosity->alpha, e.artificial_viscosity->beta};
-  s.artificial_stress.reset();
-  if (e.artificial_stress) s.artificial_stress = ArtificialStressSettings{e.artificial_stress->epsilon, e.artificial_stress->exponent};
-  s.density_diffusion.reset();
-  if (e.density_diffusion) s.density_diffusion = DensityDiffusionSettings{e.density_diffusion->delta};
+  s.viscosity = e.artificial_viscosity;
+  s.artificial_stress = e.artificial_stress;
+  s.density_diffusion = e.density_diffusion;
   s.lennard_jones.reset();
   if (e.lennard_jones_wall) {
     s.lennard_jones = LennardJonesSettings{lennard_jones_strength(scene), e.lennard_jones_wall->r0_factor, wall_spacing(scene)};
   }
-  s.ghosts.reset();
-  if (e.ghost_walls) s.ghosts = *e.ghost_walls == Slip::free_slip ? GhostSlip::free_slip : GhostSlip::no_slip;
+  s.ghosts = e.ghost_walls;
   s.ghost_pressure = e.ghost_pressure_mirrored ? GhostPressure::mirrored : GhostPressure::hydrostatic;
-  s.geometry.container = box(scene.container.box);
+  s.geometry.container = scene.container.box;
   s.geometry.open_top = scene.container.open_top;
   s.geometry.outflow = scene.container.outflow;
-  for (const Rect& o : scene.obstacles) s.geometry.obstacles.push_back(box(o));
+  s.geometry.obstacles = scene.obstacles;
   s.cfl = scene.time.cfl;
   s.dt_max = scene.time.dt_max;
   s.stepping = scene.time.stepping;
@@ -88,12 +58,12 @@ Simulation build_simulation(const Scene& scene) {
   sim.refresh();
   if (const auto& st = scene.effects.static_refinement) {
     if (st->box) {
-      refine::refine_region(sim, box(*st->box), pattern(st->pattern), st->rsp_k);
+      refine::refine_region(sim, *st->box, st->pattern, st->rsp_k);
     } else {
-      refine::refine_all(sim, pattern(st->pattern), st->rsp_k);
+      refine::refine_all(sim, st->pattern, st->rsp_k);
     }
   }
-  if (scene.effects.refinement) refine::add_refinement_stage(sim, refinement_settings(*scene.effects.refinement));
+  if (scene.effects.refinement) refine::add_refinement_stage(sim, *scene.effects.refinement);
   return sim;
 }
 

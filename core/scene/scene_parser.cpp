@@ -193,7 +193,7 @@ Material parse_material(const Json& j, const std::string& path) {
   ObjectReader r(j, path, {"rho0", "gamma", "c0", "mach_factor", "reference_speed", "reference_height"});
   Material m;
   m.rho0 = r.number("rho0");
-  m.gamma = r.number("gamma", 7.0);
+  m.gamma = r.number("gamma", Material{}.gamma);
   m.c0 = r.optional_number("c0");
   m.mach_factor = r.optional_number("mach_factor");
   m.reference_speed = r.optional_number("reference_speed");
@@ -234,11 +234,12 @@ Refinement parse_refinement(const Json& j, const std::string& path) {
   ObjectReader r(j, path, keys, std::string("criterion ") + to_string(f.criterion));
   if (f.criterion == Criterion::velocity) f.v_threshold = r.number("v_threshold");
   if (f.criterion == Criterion::zone) f.zone = parse_rect(r.at("zone"), r.path("zone"));
-  if (f.criterion == Criterion::few_neighbours) f.min_neighbours = r.integer("min_neighbours", 8);
-  f.pattern = r.choice<Pattern>("pattern", kPatterns, Pattern::aap);
-  f.rsp_k = r.number("rsp_k", 1.0);
-  f.check_interval = r.integer("check_interval", 100);
-  f.max_level = r.integer("max_level", 1);
+  const Refinement d;
+  if (f.criterion == Criterion::few_neighbours) f.min_neighbours = r.integer("min_neighbours", d.min_neighbours);
+  f.pattern = r.choice<Pattern>("pattern", kPatterns, d.pattern);
+  f.rsp_k = r.number("rsp_k", d.rsp_k);
+  f.check_interval = r.integer("check_interval", d.check_interval);
+  f.max_level = r.integer("max_level", d.max_level);
   if (r.has("coarsening")) f.coarsening = parse_coarsening(r.at("coarsening"), r.path("coarsening"), f);
   return f;
 }
@@ -247,8 +248,8 @@ StaticRefinement parse_static_refinement(const Json& j, const std::string& path)
   ObjectReader r(j, path, {"box", "pattern", "rsp_k"});
   StaticRefinement s;
   if (r.has("box")) s.box = parse_rect(r.at("box"), r.path("box"));
-  s.pattern = r.choice<Pattern>("pattern", kPatterns, Pattern::aap);
-  s.rsp_k = r.number("rsp_k", 1.0);
+  s.pattern = r.choice<Pattern>("pattern", kPatterns, StaticRefinement{}.pattern);
+  s.rsp_k = r.number("rsp_k", StaticRefinement{}.rsp_k);
   return s;
 }
 
@@ -260,15 +261,17 @@ Effects parse_effects(const Json& j, const std::string& path) {
   if (r.has("gravity")) e.gravity = r.vec2("gravity");
   if (r.has("artificial_viscosity")) {
     ObjectReader v(r.at("artificial_viscosity"), r.path("artificial_viscosity"), {"alpha", "beta"});
-    e.artificial_viscosity = ArtificialViscosity{v.number("alpha", 0.02), v.number("beta", 0.0)};
+    const ArtificialViscosity d;
+    e.artificial_viscosity = ArtificialViscosity{v.number("alpha", d.alpha), v.number("beta", d.beta)};
   }
   if (r.has("artificial_stress")) {
     ObjectReader a(r.at("artificial_stress"), r.path("artificial_stress"), {"epsilon", "exponent"});
-    e.artificial_stress = ArtificialStress{a.number("epsilon", 0.2), a.integer("exponent", 4)};
+    const ArtificialStress d;
+    e.artificial_stress = ArtificialStress{a.number("epsilon", d.epsilon), a.integer("exponent", d.exponent)};
   }
   if (r.has("density_diffusion")) {
     ObjectReader dd(r.at("density_diffusion"), r.path("density_diffusion"), {"delta"});
-    e.density_diffusion = DensityDiffusion{dd.number("delta", 0.1)};
+    e.density_diffusion = DensityDiffusion{dd.number("delta", DensityDiffusion{}.delta)};
   }
   if (r.has("lennard_jones_wall")) {
     ObjectReader w(r.at("lennard_jones_wall"), r.path("lennard_jones_wall"),
@@ -276,7 +279,7 @@ Effects parse_effects(const Json& j, const std::string& path) {
     LennardJonesWall lj;
     lj.strength = w.optional_number("strength");
     lj.reference_height = w.optional_number("reference_height");
-    lj.r0_factor = w.number("r0_factor", 0.5);
+    lj.r0_factor = w.number("r0_factor", LennardJonesWall{}.r0_factor);
     lj.spacing = w.optional_number("spacing");
     e.lennard_jones_wall = lj;
   }
@@ -297,11 +300,12 @@ Time parse_time(const Json& j, const std::string& path) {
   ObjectReader r(j, path, {"end", "cfl", "output_interval", "dt_max", "stepping"});
   Time t;
   t.end = r.number("end");
-  t.cfl = r.number("cfl", 0.2);
+  const Time d;
+  t.cfl = r.number("cfl", d.cfl);
   t.output_interval = r.optional_number("output_interval");
-  t.dt_max = r.number("dt_max", 1.0);
+  t.dt_max = r.number("dt_max", d.dt_max);
   t.stepping = r.choice<TimeStepping>(
-      "stepping", {{"global", TimeStepping::global}, {"per_level", TimeStepping::per_level}}, TimeStepping::global);
+      "stepping", {{"global", TimeStepping::global}, {"per_level", TimeStepping::per_level}}, d.stepping);
   return t;
 }
 
@@ -522,7 +526,7 @@ Scene scene_from_json(const Json& doc) {
   const Json& fluid = r.at("fluid");
   if (!fluid.is_array()) fail("fluid", std::string("must be an array of regions (got ") + type_name(fluid) + ")");
   for (std::size_t i = 0; i < fluid.size(); ++i) s.fluid.push_back(parse_region(fluid[i], element("fluid", i)));
-  s.h_factor = r.number("h_factor", 1.2);
+  s.h_factor = r.number("h_factor", Scene{}.h_factor);
   s.material = parse_material(r.at("material"), "material");
   if (r.has("effects")) s.effects = parse_effects(r.at("effects"), "effects");
   s.time = parse_time(r.at("time"), "time");
