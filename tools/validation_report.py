@@ -304,7 +304,8 @@ def pareto_section(case, label, R, d0, box, window, window_text, quick, fig_name
           f"frames of {window_text}, normalised by the reference's largest |velocity|, its pressure range, and 1. "
           "\"x uniform\" is the variant's wall time (or force evaluations) over a uniform run's of the same E_v, "
           "log-log interpolated between the two uniform runs that bracket it on their front (the uniform runs that no "
-          "other uniform run beats in both cost and error); \">= r\" where the variant is less accurate than the "
+          "other uniform run beats in both cost and error; by wall time, a run is left off when another is more "
+          "accurate and at most 20 % dearer, the timings' spread, since those two costs cannot be ordered); \">= r\" where the variant is less accurate than the "
           "cheapest uniform run (r: its cost over that run's), \"<= r\" where it is more accurate than every "
           "uniform run on the chart. The wall times are those of the tables (two runs side by side); a ratio of "
           "two such times moved by 19 % between two sessions (docs/PERFORMANCE.md, \"Time steps per level\"), so "
@@ -701,12 +702,12 @@ def runtime_text(lanes, report_seconds):
             f"{lanes} side by side, those under {SHORT_RUN_S:g} s three times: {full / 60:.0f} CPU-minutes by the stored "
             f"timings, about {full / lanes / 60:.0f} minutes on {lanes} cores")
     if miss_full:
-        text += f" ({miss_full} runs without a stored timing not counted)"
+        text += f" ({miss_full} run{'s' if miss_full > 1 else ''} without a stored timing not counted: a run the watchdog stops stores none)"
     text += (f". The quick form (`scripts/validate --quick`: no 16x runs, no a/120 column, the reference at 4x, each "
              f"run once) runs {len(build_jobs(True))}: about {quick / lanes / 60:.0f} minutes on {lanes} cores by the "
              "same timings")
     if miss_quick:
-        text += f" ({miss_quick} without a stored timing)"
+        text += f" ({miss_quick} without a stored timing, not counted)"
     text += (f". Both add the build and the report itself (field errors, figures): {report_seconds / 60:.1f} minutes "
              "this time.\n")
     return text
