@@ -7,8 +7,9 @@ then writes the probe CSVs, the figures (docs/figures/validation_*.png) and docs
 
 Every run uses one OpenMP thread and two runs go side by side, so the wall times of the variants compare
 like with like; a run shorter than 30 s is repeated and its best of three wall times kept (--retime-short
-reruns only those). --quick drops the 16x resolution and the finest Martin & Moyce column (the longest runs) and
-runs each variant once (under 15 minutes on two cores); --skip-runs reuses results/validation;
+reruns only those). --quick drops the 16x resolution, the finest and the no-slip Martin & Moyce columns, the 4x
+coarsening variants and Lobovsky's RSP run, and runs each variant once (under 15 minutes on two cores, the report
+included); --skip-runs reuses results/validation;
 --only reruns the named cases (dam_break, drop, mm_column, lobovsky) and reuses the stored runs of the others.
 
 For the dam break and the drop it also samples every run's frames against a converged reference (the fully
@@ -90,7 +91,7 @@ def variants_for(case, scene, spacings, threshold, quick, extra=()):
         for pat in ("aap", "rsp"):
             v.append((f"{pat}_pl{tag}",
                       res + [f"effects.refinement={refinement(pat, threshold, 1.0)}", "time.stepping=per_level"], k))
-        if k < 4:  # refinement and coarsening, at the paper's count and at 4x
+        if k == 1 or (k == 2 and not quick):  # refinement and coarsening, at the paper's count and at 4x
             for pat in ("aap", "rsp"):
                 v.append((f"{pat}_coarsen{tag}",
                           res + [f"effects.refinement={refinement(pat, threshold, 1.0, coarsening=True)}"], k))
@@ -703,8 +704,8 @@ def runtime_text(lanes, report_seconds):
             f"timings, about {full / lanes / 60:.0f} minutes on {lanes} cores")
     if miss_full:
         text += f" ({miss_full} run{'s' if miss_full > 1 else ''} without a stored timing not counted: a run the watchdog stops stores none)"
-    text += (f". The quick form (`scripts/validate --quick`: no 16x runs, no a/120 column, the reference at 4x, each "
-             f"run once) runs {len(build_jobs(True))}: about {quick / lanes / 60:.0f} minutes on {lanes} cores by the "
+    text += (f". The quick form (`scripts/validate --quick`: no 16x runs, no a/120 or no-slip column, no coarsening "
+             f"at 4x, no RSP for Lobovsky, the reference at 4x, each run once) runs {len(build_jobs(True))}: about {quick / lanes / 60:.0f} minutes on {lanes} cores by the "
              "same timings")
     if miss_quick:
         text += f" ({miss_quick} without a stored timing, not counted)"
@@ -733,9 +734,10 @@ def build_jobs(quick):
         jobs.append(("mm_column", "cases/validation/mm_column.json", f"refined{tag}",
                      res + [f"effects.static_refinement={STATIC}"], k))
     jobs.append(("mm_column", "cases/validation/mm_column.json", "unrefined", [], 1))
-    # The floor's friction: the same fully refined run with no-slip ghost walls.
-    jobs.append(("mm_column", "cases/validation/mm_column.json", "refined_noslip",
-                 [f"effects.static_refinement={STATIC}", "effects.ghost_walls=no-slip"], 1))
+    # The floor's friction: the same fully refined run with no-slip ghost walls (full form only).
+    if not quick:
+        jobs.append(("mm_column", "cases/validation/mm_column.json", "refined_noslip",
+                     [f"effects.static_refinement={STATIC}", "effects.ghost_walls=no-slip"], 1))
     jobs.append(("mm_column", "cases/validation/mm_column.json", "aap",
                  [f"effects.refinement={refinement('aap', mm_thr)}"], 1))
     # Lobovsky: uniform runs at three resolutions (d = H/30, H/(30 sqrt 2), H/60) and the dynamic variants, rows
@@ -747,7 +749,8 @@ def build_jobs(quick):
     jobs.append(("lobovsky", lob, "unrefined_x2", [f"fluid.0.spacing={0.01 / math.sqrt(2.0)!r}"] + lob_rows, 1))
     jobs.append(("lobovsky", lob, "unrefined", lob_rows, 1))
     jobs.append(("lobovsky", lob, "aap", [f"effects.refinement={refinement('aap', lob_thr)}"] + lob_rows, 2))
-    jobs.append(("lobovsky", lob, "rsp", [f"effects.refinement={refinement('rsp', lob_thr)}"] + lob_rows, 2))
+    if not quick:
+        jobs.append(("lobovsky", lob, "rsp", [f"effects.refinement={refinement('rsp', lob_thr)}"] + lob_rows, 2))
 
     # The still tank (cases/still_tank.json, 10 s) at two spacings, rows every 10 ms (its compression mode rings at
     # 2.6 Hz): the time-averaged pressure per depth and the oscillation's amplitude.
@@ -759,9 +762,10 @@ def build_jobs(quick):
 
 
 def main():
+    global RESULTS  # --results moves the runs
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--quick", action="store_true",
-                    help="skip the 16x resolution and the finest Martin & Moyce column; run each variant once")
+                    help="the short form: no 16x runs, fewer variants, each run once (under 15 minutes)")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--skip-runs", action="store_true")
     ap.add_argument("--only", default="", help="comma-separated cases to rerun; the others' stored runs are reused")
@@ -770,7 +774,9 @@ def main():
                          "runs are reused")
     ap.add_argument("--retime-short", action="store_true",
                     help=f"rerun only the stored variants shorter than {SHORT_RUN_S:g} s (best of {REPEATS_SHORT})")
+    ap.add_argument("--results", default=RESULTS, help="where the runs go (default results/validation)")
     args = ap.parse_args()
+    RESULTS = args.results
     os.makedirs(FIGURES, exist_ok=True)
 
     H0 = 25.0
