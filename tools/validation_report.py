@@ -375,7 +375,8 @@ def local_section(label, R, reference, quantities, probes, fig_name):
     fig.tight_layout()
     fig.savefig(os.path.join(FIGURES, fig_name), dpi=110)
     plt.close(fig)
-    cols = [("variant", lambda r: r["name"]), ("wall s", lambda r: r["wall"])]
+    cols = [("variant", lambda r: r["name"] + ("" if r["completed"] else " (stopped by the watchdog: its part only)")),
+            ("wall s", lambda r: r["wall"])]
     for key, qlabel, _, _ in quantities:
         cols += [(qlabel, (lambda k: lambda r: r[k])(key)), ("rel. error", (lambda k: lambda r: r[k + "_err"])(key))]
     cols += [(f"{p}: RMS / range", (lambda p: lambda r: r["probe_" + p])(p)) for p in probes]
