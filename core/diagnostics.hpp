@@ -1,10 +1,13 @@
 #pragma once
 // Global diagnostics of the fluid: conserved quantities, energies, extremes and counts per level.
 // Every sum is a deterministic chunked reduction, identical at any thread count.
+#include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <unordered_map>
+#include <type_traits>
 #include <vector>
 
 #include "core/equation_of_state.hpp"
@@ -13,7 +16,31 @@
 
 namespace sph {
 
-struct Diagnostics {
+/// Angular momentum's type: the z component in 2D, the vector in 3D.
+template <int D>
+using Angular = std::conditional_t<D == 2, double, Vec<3>>;
+
+/// x cross v: a scalar (z component) in 2D, a vector in 3D.
+template <int D>
+Angular<D> cross(const Vec<D>& x, const Vec<D>& v) {
+  if constexpr (D == 2) {
+    return x[0] * v[1] - x[1] * v[0];
+  } else {
+    return x.cross(v);
+  }
+}
+
+template <int D>
+Angular<D> zero_angular() {
+  if constexpr (D == 2) {
+    return 0.0;
+  } else {
+    return Vec<3>::Zero();
+  }
+}
+
+template <int D>
+struct DiagnosticsT {
   double time = 0.0;
   std::uint64_t step = 0;
   double dt = 0.0;
@@ -21,8 +48,8 @@ struct Diagnostics {
   double kinetic = 0.0;    // sum m v^2 / 2
   double potential = 0.0;  // sum -m g . x
   double elastic = 0.0;    // sum m e(rho), the equation of state's stored energy
-  Vec<2> momentum = Vec<2>::Zero();
-  double angular_momentum = 0.0;  // about the origin, z component
+  Vec<D> momentum = Vec<D>::Zero();
+  Angular<D> angular_momentum = zero_angular<D>();  // about the origin (2D: its z component)
   double max_speed = 0.0;
   double max_density_error = 0.0;  // max |rho/rho0 - 1|
   std::size_t fluid = 0, ghosts = 0, walls = 0;
@@ -33,6 +60,7 @@ struct Diagnostics {
 
   double total_energy() const { return kinetic + potential + elastic; }
 };
+using Diagnostics = DiagnosticsT<2>;
 
 /// Neumaier-compensated sum: its result is the exact sum correctly rounded in all but pathological cases,
 /// so it does not change when the particles are reordered or split (mass is compared with ==).
@@ -51,12 +79,14 @@ struct CompensatedSum {
   double value() const { return sum + c; }
 };
 
-inline Diagnostics compute_diagnostics(const ParticleStore<2>& store, const TaitEquationOfState& eos,
-                                       const Vec<2>& gravity) {
+template <int D>
+DiagnosticsT<D> compute_diagnostics(const ParticleStore<D>& store, const TaitEquationOfState& eos,
+                                    const Vec<D>& gravity) {
   struct Acc {
     CompensatedSum mass;
-    double ke = 0, pe = 0, el = 0, L = 0, vmax = 0, derr = 0;
-    Vec<2> P = Vec<2>::Zero();
+    double ke = 0, pe = 0, el = 0, vmax = 0, derr = 0;
+    Angular<D> L = zero_angular<D>();
+    Vec<D> P = Vec<D>::Zero();
     std::size_t fluid = 0, ghosts = 0, walls = 0;
   };
   const auto& x = store.x.values();
@@ -82,7 +112,7 @@ inline Diagnostics compute_diagnostics(const ParticleStore<2>& store, const Tait
         a.pe = -m[i] * gravity.dot(x[i]);
         a.el = m[i] * eos.specific_energy(rho[i]);
         a.P = m[i] * v[i];
-        a.L = m[i] * (x[i][0] * v[i][1] - x[i][1] * v[i][0]);
+        a.L = m[i] * cross<D>(x[i], v[i]);
         a.vmax = v[i].norm();
         a.derr = std::abs(rho[i] / eos.rho0 - 1.0);
         return a;
@@ -103,7 +133,7 @@ inline Diagnostics compute_diagnostics(const ParticleStore<2>& store, const Tait
         c.walls = a.walls + b.walls;
         return c;
       });
-  Diagnostics d;
+  DiagnosticsT<D> d;
   d.mass = acc.mass.value();
   d.kinetic = acc.ke;
   d.potential = acc.pe;
@@ -130,7 +160,8 @@ inline Diagnostics compute_diagnostics(const ParticleStore<2>& store, const Tait
 /// is zero (and continuous) at r = r0. Add it to Diagnostics::total_energy() in runs with Lennard-Jones walls.
 /// Wall particles are binned once per call; each fluid particle sums its walls in store order and the
 /// particle sums are reduced deterministically, so the result does not depend on the thread count.
-inline double lennard_jones_energy(const ParticleStore<2>& store, double strength, double r0_factor) {
+template <int D>
+double lennard_jones_energy(const ParticleStore<D>& store, double strength, double r0_factor) {
   const auto& x = store.x.values();
   const auto& kind = store.kind.values();
   const auto& d = store.d.values();
@@ -141,28 +172,45 @@ inline double lennard_jones_energy(const ParticleStore<2>& store, double strengt
   }
   if (!(r0max > 0.0)) return 0.0;
   auto cell = [r0max](double c) { return static_cast<std::int64_t>(std::floor(c / r0max)); };
-  auto key = [](std::int64_t cx, std::int64_t cy) { return (cx << 32) ^ (cy & 0xffffffffLL); };
+  // A bin's key; bins whose keys collide share a list, which only adds candidates the distance test drops.
+  auto key = [](const std::array<std::int64_t, D>& c) {
+    if constexpr (D == 2) {
+      return (c[0] << 32) ^ (c[1] & 0xffffffffLL);
+    } else {
+      return (c[0] << 42) ^ ((c[1] & 0x1fffffLL) << 21) ^ (c[2] & 0x1fffffLL);
+    }
+  };
+  auto cells = [&](const Vec<D>& p) {
+    std::array<std::int64_t, D> c{};
+    for (int a = 0; a < D; ++a) c[static_cast<std::size_t>(a)] = cell(p[a]);
+    return c;
+  };
   std::unordered_map<std::int64_t, std::vector<std::size_t>> bins;
   for (std::size_t j = 0; j < store.size(); ++j) {
-    if (kind[j] == Kind::wall) bins[key(cell(x[j][0]), cell(x[j][1]))].push_back(j);
+    if (kind[j] == Kind::wall) bins[key(cells(x[j]))].push_back(j);
   }
+  constexpr int kAround = D == 2 ? 9 : 27;  // the bin and its neighbours, first axis slowest
   return par::reduce(
       store.size(), 0.0,
       [&](std::size_t i) {
-        if (kind[i] != Kind::fluid || !std::isfinite(x[i][0]) || !std::isfinite(x[i][1])) return 0.0;
+        if (kind[i] != Kind::fluid || !x[i].allFinite()) return 0.0;
         const double r0 = r0_factor * d[i];
-        const std::int64_t cx = cell(x[i][0]), cy = cell(x[i][1]);
+        const std::array<std::int64_t, D> c = cells(x[i]);
         double e = 0.0;
-        for (std::int64_t bx = cx - 1; bx <= cx + 1; ++bx) {
-          for (std::int64_t by = cy - 1; by <= cy + 1; ++by) {
-            const auto it = bins.find(key(bx, by));
-            if (it == bins.end()) continue;
-            for (const std::size_t j : it->second) {
-              const double r2 = (x[i] - x[j]).squaredNorm();
-              if (r2 >= r0 * r0 || r2 <= 0.0) continue;
-              const double q2 = r0 * r0 / r2, q6 = q2 * q2 * q2;
-              e += q6 * q6 - 2.0 * q6 + 1.0;
-            }
+        for (int k = 0; k < kAround; ++k) {
+          std::array<std::int64_t, D> b = c;
+          int rest = k;
+          for (int a = D - 1; a >= 0; --a) {
+            b[static_cast<std::size_t>(a)] += rest % 3 - 1;
+            rest /= 3;
+          }
+          const auto it = bins.find(key(b));
+          if (it == bins.end()) continue;
+          for (const std::size_t j : it->second) {
+            const double r2 = (x[i] - x[j]).squaredNorm();
+            if (r2 >= r0 * r0 || r2 <= 0.0) continue;
+            const double q2 = r0 * r0 / r2, q6 = q2 * q2 * q2;
+            e += q6 * q6 - 2.0 * q6 + 1.0;
           }
         }
         return m[i] * strength / 12.0 * e;

@@ -10,12 +10,21 @@
 
 namespace sph {
 
-struct FluidBlockSpec {
+/// The mass of a lattice particle of spacing d at density rho: rho d^D (evaluated left to right, as the 2D set-up
+/// always has, so its masses are unchanged to the bit).
+template <int D>
+double lattice_mass(double rho, double d) {
+  return D == 2 ? rho * d * d : rho * d * d * d;
+}
+
+template <int D>
+struct FluidBlockSpecT {
   double spacing = 1.0;   // d^0
   double h_factor = 1.2;  // h = h_factor * d
   int level = 0;
-  Vec<2> velocity = Vec<2>::Zero();
+  Vec<D> velocity = Vec<D>::Zero();
 };
+using FluidBlockSpec = FluidBlockSpecT<2>;
 
 /// Lattice points (cell centres) of spacing d in [lo, hi].
 inline std::vector<Vec<2>> lattice_rectangle(const Vec<2>& lo, const Vec<2>& hi, double d) {
@@ -26,6 +35,20 @@ inline std::vector<Vec<2>> lattice_rectangle(const Vec<2>& lo, const Vec<2>& hi,
   for (long iy = 0; iy < ny; ++iy)
     for (long ix = 0; ix < nx; ++ix)
       pts.emplace_back(lo[0] + (static_cast<double>(ix) + 0.5) * d, lo[1] + (static_cast<double>(iy) + 0.5) * d);
+  return pts;
+}
+
+/// Lattice points (cell centres) of spacing d in the 3D box [lo, hi], x fastest.
+inline std::vector<Vec<3>> lattice_box(const Vec<3>& lo, const Vec<3>& hi, double d) {
+  std::vector<Vec<3>> pts;
+  long n[3];
+  for (int a = 0; a < 3; ++a) n[a] = static_cast<long>(std::floor((hi[a] - lo[a]) / d + 1e-9));
+  pts.reserve(static_cast<std::size_t>(std::max(0L, n[0] * n[1] * n[2])));
+  for (long iz = 0; iz < n[2]; ++iz)
+    for (long iy = 0; iy < n[1]; ++iy)
+      for (long ix = 0; ix < n[0]; ++ix)
+        pts.emplace_back(lo[0] + (static_cast<double>(ix) + 0.5) * d, lo[1] + (static_cast<double>(iy) + 0.5) * d,
+                         lo[2] + (static_cast<double>(iz) + 0.5) * d);
   return pts;
 }
 
@@ -42,9 +65,10 @@ inline std::vector<Vec<2>> lattice_circle(const Vec<2>& centre, double radius, d
   return pts;
 }
 
-/// Appends fluid particles at the given points, at rest density rho0, mass rho0 d^2.
-inline std::size_t add_fluid(ParticleStore<2>& store, const std::vector<Vec<2>>& points, const FluidBlockSpec& spec,
-                             double rho0) {
+/// Appends fluid particles at the given points, at rest density rho0, mass rho0 d^D.
+template <int D>
+std::size_t add_fluid(ParticleStore<D>& store, const std::vector<Vec<D>>& points, const FluidBlockSpecT<D>& spec,
+                      double rho0) {
   const std::size_t first = store.append(points.size());
   for (std::size_t k = 0; k < points.size(); ++k) {
     const std::size_t i = first + k;
@@ -53,7 +77,7 @@ inline std::size_t add_fluid(ParticleStore<2>& store, const std::vector<Vec<2>>&
     store.a[i].setZero();
     store.rho[i] = rho0;
     store.p[i] = 0.0;
-    store.m[i] = rho0 * spec.spacing * spec.spacing;
+    store.m[i] = lattice_mass<D>(rho0, spec.spacing);
     store.h[i] = spec.h_factor * spec.spacing;
     store.d[i] = spec.spacing;
     store.level[i] = spec.level;
@@ -63,12 +87,13 @@ inline std::size_t add_fluid(ParticleStore<2>& store, const std::vector<Vec<2>>&
   return first;
 }
 
-/// Hydrostatic initial density for fluid particles in [first, end): p = rho0 g (surface - y), rho from the
-/// inverse equation of state, so that still water starts near equilibrium.
-inline void set_hydrostatic(ParticleStore<2>& store, std::size_t first, std::size_t end, double surface_y, double g,
-                            const TaitEquationOfState& eos) {
+/// Hydrostatic initial density for fluid particles in [first, end): p = rho0 g (surface - height), the height
+/// along the last axis, rho from the inverse equation of state, so that still water starts near equilibrium.
+template <int D>
+void set_hydrostatic(ParticleStore<D>& store, std::size_t first, std::size_t end, double surface, double g,
+                     const TaitEquationOfState& eos) {
   for (std::size_t i = first; i < end; ++i) {
-    const double depth = std::max(0.0, surface_y - store.x[i][1]);
+    const double depth = std::max(0.0, surface - store.x[i][D - 1]);
     store.p[i] = eos.rho0 * g * depth;
     store.rho[i] = eos.density(store.p[i]);
   }

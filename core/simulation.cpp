@@ -11,21 +11,24 @@
 
 namespace sph {
 
-Simulation::Simulation(SolverSettings settings)
+template <int D>
+SimulationT<D>::SimulationT(Settings settings)
     : settings_(std::move(settings)), integrator_(settings_.stepping, settings_.eos) {
   if (settings_.ghosts) {
     ghosts_.emplace(settings_.geometry.walls(), *settings_.ghosts, settings_.ghost_pressure,
-                    settings_.gravity.value_or(Vec<2>::Zero()), settings_.eos);
+                    settings_.gravity.value_or(Vec<D>::Zero()), settings_.eos);
   }
   sweep_ = make_sweep(settings_);
 }
 
-std::uint32_t Simulation::output_count(const ParticleView<2>& view, std::size_t i) const {
+template <int D>
+std::uint32_t SimulationT<D>::output_count(const ParticleView<D>& view, std::size_t i) const {
   if (ghosts_) return ghosts_->output_count(view, i);
   return view.kind[i] == Kind::ghost ? 0u : 1u;
 }
 
-void Simulation::prepare_neighbours() {
+template <int D>
+void SimulationT<D>::prepare_neighbours() {
   const auto view = store_.view();
   expand_offsets_.resize(view.n + 1);
   const SmoothingRange hr = par::accumulate(
@@ -38,7 +41,8 @@ void Simulation::prepare_neighbours() {
   build_neighbours(hr);
 }
 
-void Simulation::build_neighbours(const SmoothingRange& hr) {
+template <int D>
+void SimulationT<D>::build_neighbours(const SmoothingRange& hr) {
   // Parallel regions here: the scan of the output counts, the expansion (with the bounding box of what it
   // writes), the cell sort, the gather of every field, the ghosts' own values. expand_offsets_[0..n) holds
   // each particle's output count (ghosts 0, walls 1, fluid 1 + its images), written by the caller's loop.
@@ -53,8 +57,8 @@ void Simulation::build_neighbours(const SmoothingRange& hr) {
   // Each particle's grid layer is its level's (ghosts take their source's), as in build_level_grid(); the boxes
   // are reduced in the expansion loop, which writes the positions anyway.
   const int layers = hr.layers();
-  using Box = CellGrid<2>::Box;
-  using Boxes = LayerBoxes<2>;
+  using Box = typename CellGrid<D>::Box;
+  using Boxes = LayerBoxes<D>;
   const Boxes boxes = par::accumulate(
       n, Boxes{},
       [&](Boxes& b, std::size_t i) {
@@ -68,7 +72,7 @@ void Simulation::build_neighbours(const SmoothingRange& hr) {
         expand_layer_[first] = layer;
         box = box.merged(Box::of(view.x[i]));
         if (count == 1) return;
-        const GhostBuilder::Images im = ghosts_->images(view.x[i], view.v[i], view.h[i]);
+        const typename Ghosts::Images im = ghosts_->images(view.x[i], view.v[i], view.h[i]);
         for (std::uint32_t g = 1; g < count; ++g) {
           expand_src_[first + g] = static_cast<std::uint32_t>(i);
           expand_image_[first + g] = static_cast<std::int8_t>(g - 1);
@@ -77,12 +81,12 @@ void Simulation::build_neighbours(const SmoothingRange& hr) {
           box = box.merged(Box::of(im.x[g - 1]));
         }
       },
-      [](const Boxes& a, const Boxes& b) { return merged<2>(a, b); });
+      [](const Boxes& a, const Boxes& b) { return merged<D>(a, b); });
   // The cell sort of the expanded set, composed with the expansion into one source map: one layer per level
   // present, each with cells sized by its finest support and queries reaching h_i + its largest h
   // (core/neighbour_cells.hpp).
-  std::array<CellGrid<2>::LayerSpec, kGridLayers> spec;
-  neighbour_layers<2>(hr, boxes, spec);
+  std::array<typename CellGrid<D>::LayerSpec, kGridLayers> spec;
+  neighbour_layers<D>(hr, boxes, spec);
   grid_.build_layers(spec.data(), layers, expand_x_.data(), layers > 1 ? expand_layer_.data() : nullptr, m);
   const std::uint32_t* order = grid_.order().data();
   const std::uint32_t* src = expand_src_.data();
@@ -97,7 +101,8 @@ void Simulation::build_neighbours(const SmoothingRange& hr) {
   }
 }
 
-void Simulation::refresh() {
+template <int D>
+void SimulationT<D>::refresh() {
   auto s = store_.view();
   const TaitEquationOfState eos = settings_.eos;
   par::parallel_for(s.n, [&](std::size_t i) {
@@ -108,12 +113,14 @@ void Simulation::refresh() {
   dt_ = next_dt();
 }
 
-double Simulation::next_dt() const {
+template <int D>
+double SimulationT<D>::next_dt() const {
   const double dt = settings_.cfl * std::min(limits_.dt_force, limits_.dt_cfl);
   return std::min(dt, settings_.dt_max);
 }
 
-void Simulation::count_work(int finest, const SweepLimits& lim) {
+template <int D>
+void SimulationT<D>::count_work(int finest, const SweepLimits& lim) {
   // Particles per level (the levels do not change within a step), then how many times each was due: bin b is
   // due every 2^(finest - b) of the 2^finest substeps, i.e. 2^b times a step.
   std::array<std::uint64_t, Work::kLevels> per_level{};
@@ -128,7 +135,8 @@ void Simulation::count_work(int finest, const SweepLimits& lim) {
   work_.substeps += 1u << finest;
 }
 
-void Simulation::store_restored() {
+template <int D>
+void SimulationT<D>::store_restored() {
   const auto s = store_.view();
   int finest = 0;
   for (std::size_t i = 0; i < s.n; ++i)
@@ -136,7 +144,8 @@ void Simulation::store_restored() {
   limits_.finest_bin = finest;
 }
 
-Activity Simulation::activity(int k, int finest) {
+template <int D>
+Activity SimulationT<D>::activity(int k, int finest) {
   Activity act = integrator_.activity(k, finest);
   if (act.active_bin == 0) return act;  // every particle is due
   const auto s = store_.view();
@@ -149,7 +158,8 @@ Activity Simulation::activity(int k, int finest) {
   return act;
 }
 
-StepInfo Simulation::step(double dt_cap) {
+template <int D>
+StepInfo SimulationT<D>::step(double dt_cap) {
   const double dt = std::min(dt_, dt_cap);
   const bool watch = settings_.watchdog.enabled;
   const Integrator& integ = integrator_;
@@ -256,21 +266,24 @@ StepInfo Simulation::step(double dt_cap) {
   return {dt, limits_, substeps};
 }
 
-void Simulation::run_stages() {
+template <int D>
+void SimulationT<D>::run_stages() {
   bool changed = false;
   for (auto& stage : stages_) changed = stage->after_step(*this) || changed;
   if (changed) refresh();
 }
 
-void Simulation::run_until(double t_end) {
+template <int D>
+void SimulationT<D>::run_until(double t_end) {
   while (time_ < t_end * (1.0 - 1e-14)) {
     step(t_end - time_);
     run_stages();
   }
 }
 
-Diagnostics Simulation::diagnostics() const {
-  Diagnostics d = compute_diagnostics(store_, settings_.eos, settings_.gravity.value_or(Vec<2>::Zero()));
+template <int D>
+DiagnosticsT<D> SimulationT<D>::diagnostics() const {
+  DiagnosticsT<D> d = compute_diagnostics<D>(store_, settings_.eos, settings_.gravity.value_or(Vec<D>::Zero()));
   d.time = time_;
   d.step = step_;
   d.dt = dt_;
@@ -278,5 +291,8 @@ Diagnostics Simulation::diagnostics() const {
   d.removed_mass = removed_.mass.value();
   return d;
 }
+
+template class SimulationT<2>;
+template class SimulationT<3>;
 
 }  // namespace sph

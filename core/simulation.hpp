@@ -30,16 +30,18 @@
 
 namespace sph {
 
-class Simulation;
+template <int D>
+class SimulationT;
 
 /// A per-stage effect (refinement, probes, output): one call between steps, never one per particle.
-class Stage {
+template <int D>
+class StageT {
  public:
-  virtual ~Stage() = default;
+  virtual ~StageT() = default;
   virtual const char* name() const = 0;
   /// Called after every step. Returns true when it changed the particle set (the solver then rebuilds
   /// ghosts and grid and re-evaluates the rates before the next step).
-  virtual bool after_step(Simulation& sim) = 0;
+  virtual bool after_step(SimulationT<D>& sim) = 0;
 };
 
 /// The work of the steps taken so far (this process; not part of the state): what accuracy costs, counted.
@@ -57,15 +59,21 @@ struct StepInfo {
   int substeps = 1;    // 2^B
 };
 
-class Simulation {
+/// The driver in D = 2 or 3 dimensions (both are compiled; the scene's container fixes which one runs).
+template <int D>
+class SimulationT {
  public:
-  explicit Simulation(SolverSettings settings);
+  using Settings = SolverSettingsT<D>;
+  using Stage = StageT<D>;
+  using Ghosts = GhostBuilderT<D>;
 
-  const SolverSettings& settings() const { return settings_; }
-  ParticleStore<2>& store() { return store_; }
-  const ParticleStore<2>& store() const { return store_; }
-  const CellGrid<2>& grid() const { return grid_; }
-  const GhostBuilder* ghosts() const { return ghosts_ ? &*ghosts_ : nullptr; }
+  explicit SimulationT(Settings settings);
+
+  const Settings& settings() const { return settings_; }
+  ParticleStore<D>& store() { return store_; }
+  const ParticleStore<D>& store() const { return store_; }
+  const CellGrid<D>& grid() const { return grid_; }
+  const Ghosts* ghosts() const { return ghosts_ ? &*ghosts_ : nullptr; }
   const Integrator& integrator() const { return integrator_; }
   const Work& work() const { return work_; }
 
@@ -111,12 +119,12 @@ class Simulation {
   /// Runs every stage once; refreshes if one changed the particles.
   void run_stages();
 
-  Diagnostics diagnostics() const;
+  DiagnosticsT<D> diagnostics() const;
   const SweepLimits& last_limits() const { return limits_; }
   const char* sweep_name() const { return sweep_->name(); }
 
   /// Drops ghost particles from the store (for output and checkpoints); refresh() brings them back.
-  void remove_ghosts() { GhostBuilder::remove(store_); }
+  void remove_ghosts() { Ghosts::remove(store_); }
 
   /// Rebuilds the ghosts and the cell grid and reorders the store into cell order, with one gather of
   /// every field: old ghosts dropped and new ones added (a stream expansion) and the cell sort composed
@@ -130,20 +138,20 @@ class Simulation {
   /// Adds a finished step's work (finest bin, summed limits of its sweeps) to work_.
   void count_work(int finest, const SweepLimits& lim);
   /// How many entries particle i has in the expanded set: ghosts 0, walls 1, fluid 1 + its images.
-  std::uint32_t output_count(const ParticleView<2>& view, std::size_t i) const;
+  std::uint32_t output_count(const ParticleView<D>& view, std::size_t i) const;
   /// prepare_neighbours() from its second pass on: expand_offsets_[0..n) holds the output counts and hr the
   /// fluid's smoothing-length range (the step computes both in its kick loop).
   void build_neighbours(const SmoothingRange& hr);
 
-  SolverSettings settings_;
-  ParticleStore<2> store_;
-  CellGrid<2> grid_;
-  std::optional<GhostBuilder> ghosts_;
+  Settings settings_;
+  ParticleStore<D> store_;
+  CellGrid<D> grid_;
+  std::optional<Ghosts> ghosts_;
   Integrator integrator_;
-  std::unique_ptr<SweepBase> sweep_;
+  std::unique_ptr<SweepBase<D>> sweep_;
   std::vector<std::unique_ptr<Stage>> stages_;
   SweepLimits limits_;
-  ParticleStore<2> last_good_;
+  ParticleStore<D> last_good_;
   SweepLimits last_good_limits_;  // limits_ of the last good state (restored with it)
   RemovedFluid removed_, last_good_removed_;
   // Step workspace of prepare_neighbours (reused, so a step allocates nothing once sizes settle).
@@ -151,7 +159,7 @@ class Simulation {
   std::vector<std::uint32_t> due_prefix_;  // Activity::due_prefix of the current substep
   std::vector<std::int8_t> expand_image_;
   std::vector<std::uint8_t> expand_layer_;  // each expanded particle's grid layer (its source's level)
-  std::vector<Vec<2>> expand_x_;  // the state before the current step (watchdog rollback)
+  std::vector<Vec<D>> expand_x_;  // the state before the current step (watchdog rollback)
   Work work_;
   double time_ = 0.0;
   std::uint64_t step_ = 0;
@@ -159,5 +167,10 @@ class Simulation {
   int last_substeps_ = 1;
   double dt_ = 0.0;
 };
+
+extern template class SimulationT<2>;
+extern template class SimulationT<3>;
+using Simulation = SimulationT<2>;
+using Stage = StageT<2>;
 
 }  // namespace sph

@@ -34,20 +34,31 @@ struct LennardJonesSettings {
   double spacing = 0.0;    // wall particle spacing (0: half the finest fluid spacing the scene can reach)
 };
 
-struct SolverSettings {
+/// Gravity's default: 9.81 m/s^2 down the last axis (y in 2D, z in 3D).
+template <int D>
+Vec<D> standard_gravity() {
+  Vec<D> g = Vec<D>::Zero();
+  g[D - 1] = -9.81;
+  return g;
+}
+
+template <int D>
+struct SolverSettingsT {
   TaitEquationOfState eos;
-  std::optional<Vec<2>> gravity = Vec<2>(0.0, -9.81);
+  std::optional<Vec<D>> gravity = standard_gravity<D>();
   std::optional<ViscositySettings> viscosity = ViscositySettings{};
   std::optional<ArtificialStressSettings> artificial_stress;  // off by default (PHYSICS.md: optional effect)
   std::optional<DensityDiffusionSettings> density_diffusion;  // off by default (PHYSICS.md: optional effect)
   std::optional<LennardJonesSettings> lennard_jones;
   std::optional<GhostSlip> ghosts = GhostSlip::free_slip;
   GhostPressure ghost_pressure = GhostPressure::hydrostatic;
-  Geometry2 geometry;
+  Geometry<D> geometry;
   double cfl = 0.2;
   double dt_max = 1.0;  // upper bound on the step (s)
   TimeStepping stepping = TimeStepping::global;
   WatchdogSettings watchdog;
 };
+
+using SolverSettings = SolverSettingsT<2>;
 
 }  // namespace sph

@@ -18,55 +18,56 @@
 
 namespace sph {
 
+template <int D>
 class SweepBase {
  public:
   virtual ~SweepBase() = default;
-  virtual SweepLimits run(ParticleView<2> s, const CellGrid<2>& grid, Activity act = {}) const = 0;
+  virtual SweepLimits run(ParticleView<D> s, const CellGrid<D>& grid, Activity act = {}) const = 0;
   /// The effects in the pack, e.g. "continuity+pressure+viscosity|lj" (fluid pairs | wall pairs).
   virtual const char* name() const = 0;
 };
 
-template <class Fluid, class Wall>
-class SweepImpl final : public SweepBase {
+template <int D, class Fluid, class Wall>
+class SweepImpl final : public SweepBase<D> {
  public:
-  SweepImpl(Fluid f, Wall w, double c0, Vec<2> g, std::string name)
+  SweepImpl(Fluid f, Wall w, double c0, Vec<D> g, std::string name)
       : sweep_(std::move(f), std::move(w), c0, std::move(g)), name_(std::move(name)) {}
-  SweepLimits run(ParticleView<2> s, const CellGrid<2>& grid, Activity act = {}) const override {
+  SweepLimits run(ParticleView<D> s, const CellGrid<D>& grid, Activity act = {}) const override {
     return sweep_(s, grid, act);
   }
   const char* name() const override { return name_.c_str(); }
 
  private:
-  PairSweep<2, Fluid, Wall> sweep_;
+  PairSweep<D, Fluid, Wall> sweep_;
   std::string name_;
 };
 
 namespace sweep_detail {
 
-template <class Fluid>
-std::unique_ptr<SweepBase> with_walls(Fluid fluid, const SolverSettings& s, std::string name) {
-  const Vec<2> g = s.gravity.value_or(Vec<2>::Zero());
+template <int D, class Fluid>
+std::unique_ptr<SweepBase<D>> with_walls(Fluid fluid, const SolverSettingsT<D>& s, std::string name) {
+  const Vec<D> g = s.gravity.value_or(Vec<D>::Zero());
   if (s.lennard_jones) {
     auto wall = std::make_tuple(LennardJonesWall{s.lennard_jones->strength, s.lennard_jones->r0_factor});
-    return std::make_unique<SweepImpl<Fluid, decltype(wall)>>(std::move(fluid), std::move(wall), s.eos.c0, g,
+    return std::make_unique<SweepImpl<D, Fluid, decltype(wall)>>(std::move(fluid), std::move(wall), s.eos.c0, g,
                                                              name + "|lj");
   }
-  return std::make_unique<SweepImpl<Fluid, std::tuple<>>>(std::move(fluid), std::tuple<>{}, s.eos.c0, g, name);
+  return std::make_unique<SweepImpl<D, Fluid, std::tuple<>>>(std::move(fluid), std::tuple<>{}, s.eos.c0, g, name);
 }
 
-template <class Fluid>
-std::unique_ptr<SweepBase> with_diffusion(Fluid fluid, const SolverSettings& s, std::string name) {
+template <int D, class Fluid>
+std::unique_ptr<SweepBase<D>> with_diffusion(Fluid fluid, const SolverSettingsT<D>& s, std::string name) {
   if (s.density_diffusion) {
     const double c0 = s.eos.c0;
-    const Vec<2> g = s.gravity.value_or(Vec<2>::Zero());
-    const DensityDiffusion<2> dd{s.density_diffusion->delta, c0, (s.eos.rho0 / (c0 * c0)) * g};
+    const Vec<D> g = s.gravity.value_or(Vec<D>::Zero());
+    const DensityDiffusion<D> dd{s.density_diffusion->delta, c0, (s.eos.rho0 / (c0 * c0)) * g};
     return with_walls(std::tuple_cat(std::move(fluid), std::make_tuple(dd)), s, name + "+density_diffusion");
   }
   return with_walls(std::move(fluid), s, std::move(name));
 }
 
-template <class Fluid>
-std::unique_ptr<SweepBase> with_stress(Fluid fluid, const SolverSettings& s, std::string name) {
+template <int D, class Fluid>
+std::unique_ptr<SweepBase<D>> with_stress(Fluid fluid, const SolverSettingsT<D>& s, std::string name) {
   if (s.artificial_stress) {
     const ArtificialStress as{s.artificial_stress->epsilon, s.artificial_stress->exponent};
     return with_diffusion(std::tuple_cat(std::move(fluid), std::make_tuple(as)), s, name + "+artificial_stress");
@@ -76,7 +77,8 @@ std::unique_ptr<SweepBase> with_stress(Fluid fluid, const SolverSettings& s, std
 
 }  // namespace sweep_detail
 
-inline std::unique_ptr<SweepBase> make_sweep(const SolverSettings& s) {
+template <int D>
+std::unique_ptr<SweepBase<D>> make_sweep(const SolverSettingsT<D>& s) {
   const std::tuple<Continuity, PressureGradient> base{};
   if (s.viscosity) {
     const ArtificialViscosity av{s.viscosity->alpha, s.viscosity->beta, s.eos.c0};

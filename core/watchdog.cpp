@@ -19,14 +19,22 @@ const char* to_string(FailureKind kind) {
 }
 
 std::string FailureReport::message() const {
+  std::string at = "(";
+  char num[32];
+  for (Eigen::Index k = 0; k < position.size(); ++k) {
+    std::snprintf(num, sizeof num, "%s%.6g", k > 0 ? ", " : "", position[k]);
+    at += num;
+  }
+  at += ")";
   char buf[512];
-  std::snprintf(buf, sizeof buf, "run stopped at step %llu, t = %.6g s: particle %llu at (%.6g, %.6g): %s. Likely cause: %s",
-                static_cast<unsigned long long>(step), time, static_cast<unsigned long long>(id), position[0],
-                position[1], quantity.c_str(), cause.c_str());
+  std::snprintf(buf, sizeof buf, "run stopped at step %llu, t = %.6g s: particle %llu at %s: %s. Likely cause: %s",
+                static_cast<unsigned long long>(step), time, static_cast<unsigned long long>(id), at.c_str(),
+                quantity.c_str(), cause.c_str());
   return buf;
 }
 
-bool find_failure(const ParticleStore<2>& store, const Geometry2& geometry, double rho0,
+template <int D>
+bool find_failure(const ParticleStore<D>& store, const Geometry<D>& geometry, double rho0,
                   const WatchdogSettings& settings, FailureReport& out) {
   constexpr std::size_t none = std::numeric_limits<std::size_t>::max();
   struct Hit {
@@ -35,10 +43,9 @@ bool find_failure(const ParticleStore<2>& store, const Geometry2& geometry, doub
   };
   auto classify = [&](std::size_t i) -> int {
     if (store.kind[i] != Kind::fluid) return -1;
-    const Vec<2>& x = store.x[i];
-    const Vec<2>& v = store.v[i];
-    if (!std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(v[0]) || !std::isfinite(v[1]) ||
-        !std::isfinite(store.rho[i]) || !std::isfinite(store.p[i]))
+    const Vec<D>& x = store.x[i];
+    const Vec<D>& v = store.v[i];
+    if (!x.allFinite() || !v.allFinite() || !std::isfinite(store.rho[i]) || !std::isfinite(store.p[i]))
       return 0;
     if (std::abs(store.rho[i] / rho0 - 1.0) > settings.max_density_error) return 1;
     if (!geometry.in_fluid_domain(x)) return geometry.left_through_open_top(x, store.vh[i]) ? 3 : 2;
@@ -80,8 +87,8 @@ bool find_failure(const ParticleStore<2>& store, const Geometry2& geometry, doub
       break;
     default:
       out.kind = FailureKind::left_open_top;
-      std::snprintf(buf, sizeof buf, "the particle left the domain through the open top (over the rim at y = %.6g m, "
-                    "beside the container)", geometry.container.hi[1]);
+      std::snprintf(buf, sizeof buf, "the particle left the domain through the open top (over the rim at %s = %.6g m, "
+                    "beside the container)", D == 2 ? "y" : "z", geometry.container.hi[D - 1]);
       out.quantity = buf;
       out.cause = "a splash over the rim: raise the walls (container.hi) or let the scene remove such fluid "
                   "(container.outflow: \"remove\")";
@@ -89,5 +96,10 @@ bool find_failure(const ParticleStore<2>& store, const Geometry2& geometry, doub
   }
   return true;
 }
+
+template bool find_failure<2>(const ParticleStore<2>&, const Geometry<2>&, double, const WatchdogSettings&,
+                              FailureReport&);
+template bool find_failure<3>(const ParticleStore<3>&, const Geometry<3>&, double, const WatchdogSettings&,
+                              FailureReport&);
 
 }  // namespace sph

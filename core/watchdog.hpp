@@ -2,6 +2,7 @@
 // The watchdog checks the state after every step: a NaN or Inf, a density error past a limit, a particle
 // leaving the domain (through a wall, or over the rim of an open top). On failure the simulation is put back to the last good state (the step before) and a
 // SimulationFailure names the step, time, particle, quantity and the likely cause.
+#include <Eigen/Core>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -28,7 +29,7 @@ struct FailureReport {
   std::uint64_t step = 0;
   double time = 0.0;
   ParticleId id = 0;
-  Vec<2> position = Vec<2>::Zero();
+  Eigen::VectorXd position;  // D entries
   std::string quantity;
   std::string cause;
   std::string message() const;
@@ -44,7 +45,8 @@ class SimulationFailure : public std::runtime_error {
 };
 
 /// Scans the fluid particles; returns the failure of the lowest-index offender (deterministic), if any.
-bool find_failure(const ParticleStore<2>& store, const Geometry2& geometry, double rho0,
+template <int D>
+bool find_failure(const ParticleStore<D>& store, const Geometry<D>& geometry, double rho0,
                   const WatchdogSettings& settings, FailureReport& out);
 
 }  // namespace sph

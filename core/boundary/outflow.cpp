@@ -4,7 +4,8 @@
 
 namespace sph {
 
-RemovedFluid remove_outflow(ParticleStore<2>& store, const Geometry2& geometry) {
+template <int D>
+RemovedFluid remove_outflow(ParticleStore<D>& store, const Geometry<D>& geometry) {
   RemovedFluid removed;
   if (!geometry.open_top) return removed;
   const auto leaves = [&](std::size_t i) {
@@ -20,5 +21,8 @@ RemovedFluid remove_outflow(ParticleStore<2>& store, const Geometry2& geometry) 
   store.compact([&](std::size_t i) { return !leaves(i); });
   return removed;
 }
+
+template RemovedFluid remove_outflow<2>(ParticleStore<2>&, const Geometry<2>&);
+template RemovedFluid remove_outflow<3>(ParticleStore<3>&, const Geometry<3>&);
 
 }  // namespace sph

@@ -31,6 +31,7 @@ struct RemovedFluid {
 /// vh traced back crosses a side line above the rim), keeping the others in order (one compaction of every
 /// field through the registry, only when something leaves). Particles that left through a wall stay for the
 /// watchdog. Deterministic: the same particles in the same order at any thread count. Returns what it removed.
-RemovedFluid remove_outflow(ParticleStore<2>& store, const Geometry2& geometry);
+template <int D>
+RemovedFluid remove_outflow(ParticleStore<D>& store, const Geometry<D>& geometry);
 
 }  // namespace sph

@@ -327,7 +327,7 @@ void Runner::write_summary(const RunSummary& r, const FailureReport* failure) {
                     {"step", failure->step},
                     {"time", failure->time},
                     {"particle", failure->id},
-                    {"position", {failure->position[0], failure->position[1]}},
+                    {"position", std::vector<double>(failure->position.data(), failure->position.data() + failure->position.size())},
                     {"quantity", failure->quantity},
                     {"cause", failure->cause},
                     {"last_good_step", r.final.step},

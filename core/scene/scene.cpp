@@ -74,7 +74,7 @@ double estimated_fluid_particles(const Scene& s) {
 
 double wall_length(const Scene& s) {
   double length = 0.0;
-  for (const Wall2& w : solver_settings(s).geometry.walls()) length += w.length();
+  for (const Wall2& w : solver_settings(s).geometry.walls()) length += w.span();
   return length;
 }
 
@@ -97,7 +97,7 @@ double estimated_ghost_particles(const Scene& s) {
   if (s.effects.static_refinement) d /= 2.0;
   const double rows = std::ceil(2.0 * s.h_factor);
   double bound = 0.0;
-  for (const Wall2& w : solver_settings(s).geometry.walls()) bound += (w.length() / d + 1.0) * rows + rows * rows;
+  for (const Wall2& w : solver_settings(s).geometry.walls()) bound += (w.span() / d + 1.0) * rows + rows * rows;
   return std::min(bound, GhostBuilder::kMaxGhosts * estimated_fluid_particles(s));
 }
 
