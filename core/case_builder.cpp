@@ -55,6 +55,23 @@ Simulation make_still_tank(const TankSpec& spec) {
   return sim;
 }
 
+SimulationT<3> make_still_tank(const Tank3Spec& spec) {
+  SolverSettingsT<3> s;
+  s.eos.rho0 = 1000.0;
+  s.eos.c0 = sound_speed_from_height(spec.mach_factor, kG, spec.reference_height);
+  s.geometry.container = {Vec<3>(0, 0, 0), Vec<3>(spec.length, spec.width, 2.0 * spec.depth)};
+  s.ghost_pressure = spec.ghost_pressure;
+  SimulationT<3> sim(s);
+  FluidBlockSpecT<3> block;
+  block.spacing = spec.spacing;
+  block.h_factor = spec.h_factor;
+  add_fluid(sim.store(), lattice_box(Vec<3>(0, 0, 0), Vec<3>(spec.length, spec.width, spec.depth), spec.spacing),
+            block, s.eos.rho0);
+  set_hydrostatic(sim.store(), 0, sim.store().size(), spec.depth, kG, s.eos);
+  sim.refresh();
+  return sim;
+}
+
 Simulation make_dam_break(const DamBreakSpec& spec) {
   SolverSettings s;
   s.eos.rho0 = 1000.0;

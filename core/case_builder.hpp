@@ -23,6 +23,19 @@ struct TankSpec {
   bool density_diffusion = false;  // delta-SPH (delta = 0.1) with the hydrostatic correction
 };
 
+/// Still water in a 3D box tank (open top, hydrostatic start, free-slip ghost walls on the floor and four sides).
+struct Tank3Spec {
+  double length = 1.0;  // x
+  double width = 0.4;   // y
+  double depth = 0.5;   // water depth, z; the walls reach twice as high
+  double spacing = 0.05;
+  double h_factor = 1.2;
+  double mach_factor = 10.0;
+  // c0 = mach_factor sqrt(2 g H), H = depth / 2, as for the 2D tank: the floor's compression is 1 / mach_factor^2.
+  double reference_height = 0.25;
+  GhostPressure ghost_pressure = GhostPressure::hydrostatic;
+};
+
 struct DamBreakSpec {
   double column_width = 25.0;
   double column_height = 25.0;
@@ -62,6 +75,8 @@ struct DropSpec {
 
 /// Still water in a closed-sided open tank (hydrostatic start), ghost walls (free-slip).
 Simulation make_still_tank(const TankSpec& spec);
+/// The 3D still tank.
+SimulationT<3> make_still_tank(const Tank3Spec& spec);
 /// The paper's breaking dam: square column against the left wall, gravity, free-slip walls.
 Simulation make_dam_break(const DamBreakSpec& spec);
 /// The paper's splash of a drop into a pool.

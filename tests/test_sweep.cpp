@@ -117,32 +117,35 @@ TEST(Sweep, MixedLevelCloudHasZeroNetForceAndTorque) {
 // ---------------------------------------------------------------------------------------------------
 // (b) Brute-force twin: eqs. (5), (6), (9), (10) over all pairs, written from PHYSICS.md.
 
-struct Reference {
+template <int D>
+struct ReferenceT {
   std::vector<double> drho, drho_scale, kick_rho;
-  std::vector<Vec<2>> a, kick;
+  std::vector<Vec<D>> a, kick;
   std::vector<std::uint8_t> due;
   std::vector<double> a_scale;
   double dt_force = std::numeric_limits<double>::infinity();
   double dt_cfl = std::numeric_limits<double>::infinity();
   std::size_t pairs = 0;
 };
+using Reference = ReferenceT<2>;
 
 // With time bins (sph::Activity, core/sweep.hpp): a particle's bin is min(level, cap); a pair is evaluated
 // when the larger of its two bins is at least the active bin, its terms weighted by 2^-(that bin); gravity
 // and the wall terms belong to a due particle's own bin. `kick` holds the weighted sums; for a due particle,
 // a = 2^b kick and its limits are scaled by 2^b. The default activity is the single-rate sweep.
-Reference brute_force(const ParticleStore<2>& s, const SolverSettings& st, sph::Activity act = {}) {
-  using K = sph::CubicSpline<2>;
+template <int D>
+ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<D>& st, sph::Activity act = {}) {
+  using K = sph::CubicSpline<D>;
   const std::size_t n = s.size();
-  Reference ref;
+  ReferenceT<D> ref;
   ref.drho.assign(n, 0.0);
   ref.drho_scale.assign(n, 0.0);
   ref.kick_rho.assign(n, 0.0);
-  ref.a.assign(n, Vec<2>::Zero());
-  ref.kick.assign(n, Vec<2>::Zero());
+  ref.a.assign(n, Vec<D>::Zero());
+  ref.kick.assign(n, Vec<D>::Zero());
   ref.due.assign(n, 0);
   ref.a_scale.assign(n, 0.0);
-  const Vec<2> g = st.gravity.value_or(Vec<2>::Zero());
+  const Vec<D> g = st.gravity.value_or(Vec<D>::Zero());
   const double c = st.eos.c0;
   const auto bin = [&](std::size_t k) { return std::min(static_cast<int>(s.level[k]), act.bin_cap); };
   for (std::size_t i = 0; i < n; ++i) {
@@ -150,11 +153,11 @@ Reference brute_force(const ParticleStore<2>& s, const SolverSettings& st, sph::
     const int bi = bin(i);
     const bool due = bi >= act.active_bin;
     const double wi = std::pow(2.0, -bi);
-    Vec<2> ai = due ? Vec<2>(wi * g) : Vec<2>(Vec<2>::Zero());
+    Vec<D> ai = due ? Vec<D>(wi * g) : Vec<D>(Vec<D>::Zero());
     double scale = g.norm(), drho = 0.0, drho_scale = 0.0, mu_max = 0.0;
     for (std::size_t j = 0; j < n; ++j) {
       if (j == i) continue;
-      const Vec<2> xij = s.x[i] - s.x[j];
+      const Vec<D> xij = s.x[i] - s.x[j];
       const double r = xij.norm();
       if (!(r < s.h[i] + s.h[j])) continue;
       if (s.kind[j] == Kind::wall) {  // eq. (10), r0 = r0_factor d_i
@@ -163,7 +166,7 @@ Reference brute_force(const ParticleStore<2>& s, const SolverSettings& st, sph::
         if (!st.lennard_jones) continue;
         const double r0 = st.lennard_jones->r0_factor * s.d[i];
         if (r >= r0 || r == 0.0) continue;
-        const Vec<2> f = wi * st.lennard_jones->strength * (std::pow(r0 / r, 12) - std::pow(r0 / r, 6)) * xij / (r * r);
+        const Vec<D> f = wi * st.lennard_jones->strength * (std::pow(r0 / r, 12) - std::pow(r0 / r, 6)) * xij / (r * r);
         ai += f;
         scale += f.norm();
         continue;
@@ -173,17 +176,17 @@ Reference brute_force(const ParticleStore<2>& s, const SolverSettings& st, sph::
       ++ref.pairs;
       const double w = std::pow(2.0, -bij);
       const double hij = 0.5 * (s.h[i] + s.h[j]);
-      const Vec<2> gradW = r > 0.0 ? Vec<2>(w * K::derivative(r, hij) * xij / r) : Vec<2>(Vec<2>::Zero());
+      const Vec<D> gradW = r > 0.0 ? Vec<D>(w * K::derivative(r, hij) * xij / r) : Vec<D>(Vec<D>::Zero());
       // Near the edge of the support grad W goes as (2 - q)^2, so an ulp of q (the sweep forms q = r (1/h_ij),
       // this r / h_ij) moves the term by 2 q / (2 - q) ulps: the term's share of the scale carries that factor.
       // (With many neighbours other terms dominate the scale; a particle whose only due pair sits at the edge
       // of its support does not.)
       const double q = r / hij;
       const double cond = q >= 1.0 && q < 2.0 ? 1.0 + 2.0 * q / (2.0 - q) : 1.0;
-      const Vec<2> vij = s.v[i] - s.v[j];
+      const Vec<D> vij = s.v[i] - s.v[j];
       double dr = s.m[j] * vij.dot(gradW);  // eq. (5)
       if (st.density_diffusion) {  // delta-SPH: psi = (rho_j - rho_i) - (rho0/c0^2) g.(x_j - x_i)
-        const Vec<2> xji = s.x[j] - s.x[i];
+        const Vec<D> xji = s.x[j] - s.x[i];
         const double psi = (s.rho[j] - s.rho[i]) - st.eos.rho0 / (c * c) * g.dot(xji);
         dr += 2.0 * st.density_diffusion->delta * hij * c * psi * xji.dot(gradW) / (r * r + 0.01 * hij * hij) *
               s.m[j] / s.rho[j];
@@ -204,7 +207,7 @@ Reference brute_force(const ParticleStore<2>& s, const SolverSettings& st, sph::
         const double f = K::value(r, hij) / K::value(0.5 * (s.d[i] + s.d[j]), hij);
         bracket += (Ri + Rj) * std::pow(f, st.artificial_stress->exponent);
       }
-      const Vec<2> f = -s.m[j] * bracket * gradW;
+      const Vec<D> f = -s.m[j] * bracket * gradW;
       ai += f;
       scale += cond * f.norm();
     }
@@ -229,13 +232,14 @@ Reference brute_force(const ParticleStore<2>& s, const SolverSettings& st, sph::
 /// n_neighbours * 1e-16 of the sum of the terms' magnitudes (~1e-14 at ~50 neighbours). 1e-12 of that sum
 /// leaves a factor ~100; a missing or extra pair changes a sum by a whole term, or, at the edge of the support
 /// where grad W vanishes, changes the pair count, which must match exactly.
-void expect_rates_match_brute_force(const ParticleStore<2>& s, const sph::SweepLimits& lim, const SolverSettings& st,
+template <int D>
+void expect_rates_match_brute_force(const ParticleStore<D>& s, const sph::SweepLimits& lim, const sph::SolverSettingsT<D>& st,
                                     const char* what, sph::Activity act = {}) {
-  const Reference ref = brute_force(s, st, act);
+  const ReferenceT<D> ref = brute_force(s, st, act);
   std::size_t checked = 0;
   for (std::size_t i = 0; i < s.size(); ++i) {
     if (s.kind[i] != Kind::fluid) {
-      EXPECT_EQ(s.a[i], Vec<2>::Zero()) << what << ": non-fluid " << i;
+      EXPECT_EQ(s.a[i], Vec<D>::Zero()) << what << ": non-fluid " << i;
       EXPECT_EQ(s.drho[i], 0.0) << what << ": non-fluid " << i;
       continue;
     }
@@ -257,8 +261,9 @@ void expect_rates_match_brute_force(const ParticleStore<2>& s, const sph::SweepL
 }
 
 /// The sweep on a grid built here (cell size 2 h_max), against the brute force.
-void expect_matches_brute_force(ParticleStore<2>& s, const SolverSettings& st, const char* what) {
-  CellGrid<2> grid;
+template <int D>
+void expect_matches_brute_force(ParticleStore<D>& s, const sph::SolverSettingsT<D>& st, const char* what) {
+  CellGrid<D> grid;
   build_grid(s, grid);
   const sph::SweepLimits lim = sph::make_sweep(st)->run(s.view(), grid);
   expect_rates_match_brute_force(s, lim, st, what);
@@ -266,13 +271,15 @@ void expect_matches_brute_force(ParticleStore<2>& s, const SolverSettings& st, c
 
 /// How many particles a term moves beyond the comparison's tolerance: the acceleration or density rate of
 /// the brute-force evaluation with the term against that without it. (A twin test is only as sharp as this.)
-std::size_t changed_accelerations(const Reference& with, const Reference& without) {
+template <int D>
+std::size_t changed_accelerations(const ReferenceT<D>& with, const ReferenceT<D>& without) {
   std::size_t n = 0;
   for (std::size_t i = 0; i < with.a.size(); ++i) n += (with.a[i] - without.a[i]).norm() > 1e-6 * with.a_scale[i];
   return n;
 }
 
-std::size_t changed_density_rates(const Reference& with, const Reference& without) {
+template <int D>
+std::size_t changed_density_rates(const ReferenceT<D>& with, const ReferenceT<D>& without) {
   std::size_t n = 0;
   for (std::size_t i = 0; i < with.drho.size(); ++i)
     n += std::abs(with.drho[i] - without.drho[i]) > 1e-6 * with.drho_scale[i];
@@ -435,6 +442,83 @@ TEST(Sweep, EqualsBruteForceWithDensityDiffusion) {
     SolverSettings off = st;
     off.density_diffusion.reset();
     EXPECT_GT(changed_density_rates(brute_force(s, st), brute_force(s, off)), 100u);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// The same twin in 3D: a two-level cloud in a 5 m cube (about 40 neighbours a particle), ghost-kind copies, and
+// a plane of wall particles at z = 0, with every optional effect and at each active bin of a two-bin step.
+
+sph::SolverSettingsT<3> twin_settings_3d() {
+  sph::SolverSettingsT<3> st;
+  st.eos.rho0 = 1000.0;
+  st.eos.c0 = 25.0;
+  st.gravity = Vec<3>(0.0, 0.0, -9.81);
+  st.ghosts.reset();
+  st.viscosity = sph::ViscositySettings{0.2, 0.5};
+  st.lennard_jones = sph::LennardJonesSettings{50.0, 0.5, 0.25};
+  return st;
+}
+
+ParticleStore<3> twin_cloud_3d(const sph::SolverSettingsT<3>& st, std::uint32_t seed) {
+  ParticleStore<3> s = random_cloud<3>(700, 5.0, 0.5, st.eos, seed, 1.5);
+  for (std::size_t i = 0; i < s.size(); i += 7) s.kind[i] = Kind::ghost;
+  for (std::size_t i = 0; i < s.size(); ++i)  // some fluid within reach of the wall plane's repulsion
+    if (s.kind[i] == Kind::fluid && i % 5 == 1) s.x[i][2] = 0.02 + 0.2 * s.d[i] * (static_cast<double>(i % 11) / 11.0);
+  for (int kx = 0; kx <= 20; ++kx) {
+    for (int ky = 0; ky <= 20; ++ky) {
+      ParticleInitT<3> w;
+      w.x = Vec<3>(0.25 * kx, 0.25 * ky, 0.0);
+      w.m = 0.0;
+      w.h = 0.0;
+      w.d = 0.125;
+      w.rho = st.eos.rho0;
+      w.kind = Kind::wall;
+      add_particle(s, w, st.eos);
+    }
+  }
+  return s;
+}
+
+TEST(Sweep, EqualsBruteForceIn3D) {
+  for (int effects = 0; effects < 3; ++effects) {
+    sph::SolverSettingsT<3> st = twin_settings_3d();
+    if (effects >= 1) st.density_diffusion = sph::DensityDiffusionSettings{0.1};
+    if (effects >= 2) st.artificial_stress = sph::ArtificialStressSettings{0.2, 4};
+    ParticleStore<3> s = twin_cloud_3d(st, 21u + static_cast<std::uint32_t>(effects));
+    SCOPED_TRACE(testing::Message() << "effects " << effects);
+    expect_matches_brute_force(s, st, "3D");
+    // The comparison sees each term: viscosity, the wall repulsion and (when on) diffusion each move many rates.
+    sph::SolverSettingsT<3> off = st;
+    off.viscosity.reset();
+    EXPECT_GT(changed_accelerations(brute_force(s, st), brute_force(s, off)), 100u);
+    off = st;
+    off.lennard_jones.reset();
+    EXPECT_GT(changed_accelerations(brute_force(s, st), brute_force(s, off)), 20u);
+    if (st.density_diffusion) {
+      off = st;
+      off.density_diffusion.reset();
+      EXPECT_GT(changed_density_rates(brute_force(s, st), brute_force(s, off)), 100u);
+    }
+  }
+}
+
+TEST(Sweep, TimeBinsEqualBruteForceIn3D) {
+  const sph::SolverSettingsT<3> st = twin_settings_3d();
+  ParticleStore<3> s = twin_cloud_3d(st, 31u);
+  CellGrid<3> grid;
+  sph::test::build_level_grid_in_order(s, grid);
+  ASSERT_EQ(grid.layer_count(), 2);
+  const auto sweep = sph::make_sweep(st);
+  for (const int active : {1, 0}) {
+    SCOPED_TRACE(testing::Message() << "active bin " << active);
+    sph::Activity act{active, sph::Integrator::kMaxBin};
+    std::vector<std::uint32_t> prefix(s.size() + 1, 0);
+    for (std::size_t i = 0; i < s.size(); ++i)
+      prefix[i + 1] = prefix[i] + (s.kind[i] != Kind::wall && act.bin(s.level[i]) >= active ? 1u : 0u);
+    act.due_prefix = prefix.data();
+    const sph::SweepLimits lim = sweep->run(s.view(), grid, act);
+    expect_rates_match_brute_force(s, lim, st, "3D bins", act);
   }
 }
 

@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "core/cell_grid.hpp"
+#include "core/diagnostics.hpp"
+#include "core/setup.hpp"
 #include "core/neighbour_cells.hpp"
 #include "core/particle_store.hpp"
 #include "core/simulation.hpp"
@@ -19,9 +21,10 @@
 namespace sph::test {
 
 /// One particle's data, for building stores by hand.
-struct ParticleInit {
-  Vec<2> x = Vec<2>::Zero();
-  Vec<2> v = Vec<2>::Zero();
+template <int D>
+struct ParticleInitT {
+  Vec<D> x = Vec<D>::Zero();
+  Vec<D> v = Vec<D>::Zero();
   double rho = 1000.0;
   double m = 1.0;
   double h = 1.0;
@@ -29,9 +32,11 @@ struct ParticleInit {
   int level = 0;
   Kind kind = Kind::fluid;
 };
+using ParticleInit = ParticleInitT<2>;
 
 /// Appends one particle; its pressure comes from `eos` (fluid and ghosts) or is zero (walls).
-inline std::size_t add_particle(ParticleStore<2>& s, const ParticleInit& p, const TaitEquationOfState& eos) {
+template <int D>
+std::size_t add_particle(ParticleStore<D>& s, const ParticleInitT<D>& p, const TaitEquationOfState& eos) {
   const std::size_t i = s.append(1);
   s.x[i] = p.x;
   s.v[i] = p.v;
@@ -45,22 +50,28 @@ inline std::size_t add_particle(ParticleStore<2>& s, const ParticleInit& p, cons
   return i;
 }
 
-/// A random cloud of `n` fluid particles in [0, side]^2 on two refinement levels (level 1: half the
-/// spacing, a quarter of the mass, half the smoothing length), with random velocities and densities
+/// A random cloud of `n` fluid particles in [0, side]^D on two refinement levels (level 1: half the
+/// spacing, 2^-D of the mass, half the smoothing length), with random velocities and densities
 /// within 1 % of rho0. Positions are jittered lattice-free uniform draws, so pair geometries are generic.
-inline ParticleStore<2> random_cloud(std::size_t n, double side, double d0, const TaitEquationOfState& eos,
-                                     std::uint32_t seed, double speed = 1.0) {
-  ParticleStore<2> s;
+template <int D = 2>
+ParticleStore<D> random_cloud(std::size_t n, double side, double d0, const TaitEquationOfState& eos,
+                              std::uint32_t seed, double speed = 1.0) {
+  ParticleStore<D> s;
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> pos(0.0, side), unit(-1.0, 1.0);
   for (std::size_t k = 0; k < n; ++k) {
     const int level = (k % 3 == 0) ? 1 : 0;
     const double d = level == 1 ? 0.5 * d0 : d0;
-    ParticleInit p;
-    p.x = Vec<2>(pos(rng), pos(rng));
-    p.v = speed * Vec<2>(unit(rng), unit(rng));
+    ParticleInitT<D> p;
+    if constexpr (D == 2) {
+      p.x = Vec<2>(pos(rng), pos(rng));
+      p.v = speed * Vec<2>(unit(rng), unit(rng));
+    } else {
+      for (int a = 0; a < D; ++a) p.x[a] = pos(rng);
+      for (int a = 0; a < D; ++a) p.v[a] = speed * unit(rng);
+    }
     p.rho = eos.rho0 * (1.0 + 0.01 * unit(rng));
-    p.m = eos.rho0 * d * d;
+    p.m = lattice_mass<D>(eos.rho0, d);
     p.h = 1.2 * d;
     p.d = d;
     p.level = level;
@@ -69,35 +80,40 @@ inline ParticleStore<2> random_cloud(std::size_t n, double side, double d0, cons
   return s;
 }
 
-inline double max_h(const ParticleStore<2>& s) {
+template <int D>
+double max_h(const ParticleStore<D>& s) {
   double hmax = 0.0;
   for (std::size_t i = 0; i < s.size(); ++i) hmax = std::max(hmax, s.h[i]);
   return hmax;
 }
 
 /// Builds the cell grid over the store and reorders the store into cell order (as the solver does).
-inline void build_grid(ParticleStore<2>& s, CellGrid<2>& grid) {
+template <int D>
+void build_grid(ParticleStore<D>& s, CellGrid<D>& grid) {
   grid.build(s.x.data(), s.size(), std::max(2.0 * max_h(s), 1e-12));
   s.gather(grid.order());
 }
 
 /// The solver's grid with one layer per level (build_level_grid), the store reordered into its order.
-inline void build_level_grid_in_order(ParticleStore<2>& s, CellGrid<2>& grid) {
+template <int D>
+void build_level_grid_in_order(ParticleStore<D>& s, CellGrid<D>& grid) {
   std::vector<std::uint8_t> layer;
   build_level_grid(s, grid, layer);
   s.gather(grid.order());
 }
 
 /// Reorders the store into cell order and runs the sweep that `settings` selects on it.
-inline SweepLimits run_sweep(ParticleStore<2>& s, const SolverSettings& settings) {
-  CellGrid<2> grid;
+template <int D>
+SweepLimits run_sweep(ParticleStore<D>& s, const SolverSettingsT<D>& settings) {
+  CellGrid<D> grid;
   build_grid(s, grid);
   return make_sweep(settings)->run(s.view(), grid);
 }
 
 /// Settings of an isolated system: no gravity, no walls, no ghosts, no wall repulsion.
-inline SolverSettings isolated_settings(double c0 = 10.0, bool viscosity = true) {
-  SolverSettings st;
+template <int D = 2>
+SolverSettingsT<D> isolated_settings(double c0 = 10.0, bool viscosity = true) {
+  SolverSettingsT<D> st;
   st.eos.rho0 = 1000.0;
   st.eos.c0 = c0;
   st.gravity.reset();
@@ -108,7 +124,8 @@ inline SolverSettings isolated_settings(double c0 = 10.0, bool viscosity = true)
 }
 
 /// Index of each id in the store (ids must be below the store's next id).
-inline std::vector<std::size_t> index_by_id(const ParticleStore<2>& s, Kind kind = Kind::fluid) {
+template <int D>
+std::vector<std::size_t> index_by_id(const ParticleStore<D>& s, Kind kind = Kind::fluid) {
   std::vector<std::size_t> idx(static_cast<std::size_t>(s.next_id()), static_cast<std::size_t>(-1));
   for (std::size_t i = 0; i < s.size(); ++i)
     if (s.kind[i] == kind) idx[static_cast<std::size_t>(s.id[i])] = i;
@@ -116,7 +133,8 @@ inline std::vector<std::size_t> index_by_id(const ParticleStore<2>& s, Kind kind
 }
 
 /// Sum of the fluid masses taken in id order, so it does not depend on the store's (cell) order.
-inline double mass_by_id(const ParticleStore<2>& s) {
+template <int D>
+double mass_by_id(const ParticleStore<D>& s) {
   double total = 0.0;
   for (std::size_t i : index_by_id(s))
     if (i != static_cast<std::size_t>(-1)) total += s.m[i];
@@ -129,7 +147,8 @@ struct MomentumScales {
   double angular = 0.0;
 };
 
-inline MomentumScales momentum_scales(const ParticleStore<2>& s) {
+template <int D>
+MomentumScales momentum_scales(const ParticleStore<D>& s) {
   MomentumScales sc;
   for (std::size_t i = 0; i < s.size(); ++i) {
     if (s.kind[i] != Kind::fluid) continue;
@@ -140,22 +159,26 @@ inline MomentumScales momentum_scales(const ParticleStore<2>& s) {
 }
 
 /// Total linear and angular momentum (about the origin) of the fluid, summed in id order.
-struct Momenta {
-  Vec<2> P = Vec<2>::Zero();
-  double L = 0.0;
+template <int D>
+struct MomentaT {
+  Vec<D> P = Vec<D>::Zero();
+  Angular<D> L = zero_angular<D>();
 };
+using Momenta = MomentaT<2>;
 
-inline Momenta momenta_by_id(const ParticleStore<2>& s) {
-  Momenta out;
+template <int D>
+MomentaT<D> momenta_by_id(const ParticleStore<D>& s) {
+  MomentaT<D> out;
   for (std::size_t i : index_by_id(s)) {
     if (i == static_cast<std::size_t>(-1)) continue;
     out.P += s.m[i] * s.v[i];
-    out.L += s.m[i] * (s.x[i][0] * s.v[i][1] - s.x[i][1] * s.v[i][0]);
+    out.L += s.m[i] * cross<D>(s.x[i], s.v[i]);
   }
   return out;
 }
 
-inline bool all_finite(const ParticleStore<2>& s) {
+template <int D>
+bool all_finite(const ParticleStore<D>& s) {
   for (std::size_t i = 0; i < s.size(); ++i) {
     if (!s.x[i].allFinite() || !s.v[i].allFinite() || !s.a[i].allFinite()) return false;
     if (!std::isfinite(s.rho[i]) || !std::isfinite(s.p[i]) || !std::isfinite(s.drho[i])) return false;
