@@ -12,6 +12,11 @@
 #include "core/boundary/ghosts.hpp"
 #include "core/boundary/wall.hpp"
 #include "core/case_builder.hpp"
+#include "core/refinement/family.hpp"
+#include "core/refinement/patterns.hpp"
+#include "core/refinement/refinement_stage.hpp"
+#include "core/refinement/split_pass.hpp"
+#include "core/setup.hpp"
 #include "tests/support/physics_helpers.hpp"
 #include "tests/support/test_scale.hpp"
 
@@ -121,7 +126,9 @@ TEST(Ghosts3D, CornerEdgeAndFaceHaveSevenThreeAndOneImages) {
       }
     }
     // The first images are the single reflections, in wall order (floor first).
-    if (im.count == 7) EXPECT_EQ(im.x[0], Vec3(0.1, 0.15, -0.05));
+    if (im.count == 7) {
+      EXPECT_EQ(im.x[0], Vec3(0.1, 0.15, -0.05));
+    }
   }
   const sph::GhostBuilderT<3> no_slip(unit_box(true).walls(), sph::GhostSlip::no_slip);
   const auto ns = no_slip.images(Vec3(0.1, 0.15, 0.05), v, 0.1);
@@ -279,6 +286,151 @@ TEST(Determinism3D, SameBitsAtOneAndTwoThreads) {
     moved += a.v[ia[id]].norm() > 0.01;
   }
   EXPECT_GT(moved, 100u);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Refinement into eight
+
+struct Totals {
+  double mass = 0.0, kinetic = 0.0;
+  Vec3 momentum = Vec3::Zero(), angular = Vec3::Zero();
+  double momentum_scale = 0.0, angular_scale = 0.0, kinetic_scale = 0.0;
+};
+
+Totals totals(const sph::ParticleStore<3>& s) {
+  Totals t;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] != Kind::fluid) continue;
+    t.mass += s.m[i];
+    t.kinetic += 0.5 * s.m[i] * s.v[i].squaredNorm();
+    t.momentum += s.m[i] * s.v[i];
+    t.angular += s.m[i] * s.x[i].cross(s.v[i]);
+    t.momentum_scale += s.m[i] * s.v[i].norm();
+    t.angular_scale += s.m[i] * s.x[i].norm() * s.v[i].norm();
+    t.kinetic_scale += 0.5 * s.m[i] * s.v[i].squaredNorm();
+  }
+  return t;
+}
+
+TEST(Refinement3D, EightSplitConservesMassMomentaAndKineticEnergy) {
+  const sph::TaitEquationOfState eos{1000.0, 20.0, 7.0};
+  for (const auto pattern : {sph::refine::Pattern::aap, sph::refine::Pattern::rsp}) {
+    sph::ParticleStore<3> s = sph::test::random_cloud<3>(400, 4.0, 0.4, eos, 5u, 2.0);
+    const Totals before = totals(s);
+    std::vector<std::uint8_t> marks(s.size(), 0);
+    std::size_t marked = 0;
+    for (std::size_t i = 0; i < s.size(); i += 3) marks[i] = 1, ++marked;
+    // No walls: conservation is the pattern's (point symmetry about the parent); the wall rule's shift is 2D's.
+    const auto r = sph::refine::split_marked<3>(s, marks, pattern, 1.0, 5, {}, 0.0);
+    ASSERT_EQ(r.refined, marked);
+    ASSERT_EQ(s.size(), 400u + 7u * marked);
+    const Totals after = totals(s);
+    // Each daughter is m/8 (exact) at x_i + o_a with v_i; the offsets sum to zero, so every total is the
+    // parent's up to the rounding of sums over ~10^3 terms: 1e-12 of each total's scale.
+    EXPECT_NEAR(after.mass, before.mass, 1e-12 * before.mass);
+    EXPECT_LE((after.momentum - before.momentum).norm(), 1e-12 * before.momentum_scale);
+    EXPECT_LE((after.angular - before.angular).norm(), 1e-12 * before.angular_scale);
+    EXPECT_NEAR(after.kinetic, before.kinetic, 1e-12 * before.kinetic_scale);
+    // Families: the eight daughters of one parent share its id as parent and carry sibling indices 0..7.
+    std::vector<std::vector<unsigned>> siblings;
+    std::vector<sph::ParticleId> parents;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      if (!sph::refine::has_parent(s.id[i])) continue;
+      EXPECT_GE(s.level[i], 1);
+      EXPECT_EQ(s.h[i], 1.2 * s.d[i]) << "h and d both halved";
+      const sph::ParticleId p = sph::refine::parent_id<3>(s.id[i]);
+      const auto it = std::find(parents.begin(), parents.end(), p);
+      if (it == parents.end()) {
+        parents.push_back(p);
+        siblings.push_back({sph::refine::sibling_index<3>(s.id[i])});
+      } else {
+        siblings[static_cast<std::size_t>(it - parents.begin())].push_back(sph::refine::sibling_index<3>(s.id[i]));
+      }
+    }
+    ASSERT_EQ(parents.size(), marked);
+    for (auto& f : siblings) {
+      std::sort(f.begin(), f.end());
+      EXPECT_EQ(f, (std::vector<unsigned>{0, 1, 2, 3, 4, 5, 6, 7}));
+    }
+  }
+}
+
+TEST(Refinement3D, CubeLatticeBecomesTheNextFinerLattice) {
+  sph::Tank3Spec spec;
+  spec.length = 0.4;
+  spec.width = 0.3;
+  spec.depth = 0.2;
+  spec.spacing = 0.05;
+  sph::SimulationT<3> sim = sph::make_still_tank(spec);
+  const double mass = sph::test::mass_by_id(sim.store());
+  sim.remove_ghosts();
+  const std::size_t n0 = sim.store().size();
+  // Away from the walls the wall rule never acts (every daughter is d/4 from its parent, the parents d/2 from
+  // the walls), so AAP turns the lattice of spacing d into exactly that of spacing d/2.
+  const std::size_t split = sph::refine::refine_all(sim, sph::refine::Pattern::aap, 1.0);
+  EXPECT_EQ(split, n0);
+  sim.remove_ghosts();
+  const auto& s = sim.store();
+  ASSERT_EQ(s.size(), 8 * n0);
+  auto finer = sph::lattice_box(Vec3(0, 0, 0), Vec3(spec.length, spec.width, spec.depth), 0.5 * spec.spacing);
+  ASSERT_EQ(finer.size(), s.size());
+  std::vector<Vec3> got;
+  for (std::size_t i = 0; i < s.size(); ++i) got.push_back(s.x[i]);
+  const auto less = [](const Vec3& a, const Vec3& b) {
+    for (int k = 2; k >= 0; --k) {
+      if (std::abs(a[k] - b[k]) > 1e-9) return a[k] < b[k];
+    }
+    return false;
+  };
+  std::sort(got.begin(), got.end(), less);
+  std::sort(finer.begin(), finer.end(), less);
+  for (std::size_t k = 0; k < got.size(); ++k) EXPECT_LE((got[k] - finer[k]).norm(), 1e-12) << k;
+  double mass_after = 0.0;  // (daughters' ids are not dense: summed in store order)
+  for (std::size_t i = 0; i < s.size(); ++i) mass_after += s.m[i];
+  EXPECT_NEAR(mass_after, mass, 1e-12 * mass);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    EXPECT_EQ(s.d[i], 0.5 * spec.spacing);
+    EXPECT_EQ(s.level[i], 1);
+  }
+}
+
+TEST(Refinement3D, RotatedPatternPointsAnAxisAtTheReferenceAndScalesByF) {
+  // Two particles of spacing d at distance r < d: F = d / r. RSP's cube has one axis along x_j - x_i and side
+  // k d / F; the three axes are orthonormal.
+  const sph::TaitEquationOfState eos{1000.0, 20.0, 7.0};
+  sph::ParticleStore<3> s;
+  sph::test::ParticleInitT<3> p;
+  p.d = 0.1;
+  p.h = 0.12;
+  p.m = 1.0;
+  p.x = Vec3(1.0, 1.0, 1.0);
+  sph::test::add_particle(s, p, eos);
+  const Vec3 dir = Vec3(1.0, 2.0, -0.5).normalized();
+  p.x = Vec3(1.0, 1.0, 1.0) + 0.08 * dir;
+  sph::test::add_particle(s, p, eos);
+  const sph::refine::NeighbourQueryIn<3> query(s);
+  const auto ref = sph::refine::find_reference(s, query, 0);
+  ASSERT_TRUE(ref.found);
+  EXPECT_NEAR(ref.F, 0.1 / 0.08, 1e-12);
+  EXPECT_LE((ref.direction - dir).norm(), 1e-12);
+  const auto o = sph::refine::rotated_scaled_pattern<3>(0.1, ref, 1.0);
+  const double side = 0.1 / ref.F;
+  Vec3 sum = Vec3::Zero();
+  for (const Vec3& a : o) {
+    sum += a;
+    EXPECT_NEAR(a.norm(), std::sqrt(3.0) * side / 4.0, 1e-15) << "a corner of the cube of side k d / F";
+    EXPECT_NEAR(std::abs(a.dot(dir)), side / 4.0, 1e-15) << "a face normal along the reference direction";
+  }
+  EXPECT_LE(sum.norm(), 1e-15);
+  const auto frame = sph::refine::frame_along(dir);
+  EXPECT_NEAR(frame[0].dot(frame[1]), 0.0, 1e-15);
+  EXPECT_NEAR(frame[0].dot(frame[2]), 0.0, 1e-15);
+  EXPECT_NEAR(frame[1].dot(frame[2]), 0.0, 1e-15);
+  EXPECT_NEAR(frame[0].cross(frame[1]).dot(frame[2]), 1.0, 1e-15) << "right-handed";
+  // AAP is the frame of the coordinate axes.
+  const auto aap = sph::refine::axis_aligned_pattern<3>(0.1);
+  for (const Vec3& a : aap)
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(std::abs(a[k]), 0.025, 1e-17);
 }
 
 }  // namespace

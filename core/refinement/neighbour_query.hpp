@@ -12,9 +12,10 @@
 
 namespace sph::refine {
 
-class NeighbourQuery {
+template <int D>
+class NeighbourQueryIn {
  public:
-  explicit NeighbourQuery(const ParticleStore<2>& store) : store_(store) {
+  explicit NeighbourQueryIn(const ParticleStore<D>& store) : store_(store) {
     // The step's cells and layers (core/neighbour_cells.hpp). The store may still hold the last step's ghosts,
     // of a level no fluid has any more: they go to the deepest layer there is (the query skips them anyway).
     build_level_grid(store, grid_, layer_);
@@ -24,7 +25,7 @@ class NeighbourQuery {
   template <class F>
   void for_each_fluid_neighbour(std::size_t i, F&& f) const {
     const auto& order = grid_.order();
-    const Vec<2> xi = store_.x[i];
+    const Vec<D> xi = store_.x[i];
     const double hi = store_.h[i];
     grid_.for_each_support_run(xi, hi, [&](std::uint32_t b, std::uint32_t e) {
       for (std::uint32_t k = b; k < e; ++k) {
@@ -38,9 +39,10 @@ class NeighbourQuery {
   }
 
  private:
-  const ParticleStore<2>& store_;
-  CellGrid<2> grid_;
+  const ParticleStore<D>& store_;
+  CellGrid<D> grid_;
   std::vector<std::uint8_t> layer_;  // each particle's grid layer
 };
+using NeighbourQuery = NeighbourQueryIn<2>;
 
 }  // namespace sph::refine

@@ -17,7 +17,8 @@ std::vector<std::size_t> level_counts(const ParticleStore<2>& store) {
   return per_level;
 }
 
-std::size_t split_with(Simulation& sim, std::vector<std::uint8_t>& marks, Pattern pattern, double rsp_k,
+template <int D>
+std::size_t split_with(SimulationT<D>& sim, std::vector<std::uint8_t>& marks, Pattern pattern, double rsp_k,
                        int max_level) {
   const SplitResult r =
       split_marked(sim.store(), marks, pattern, rsp_k, max_level, sim.settings().geometry.walls(), sim.time());
@@ -92,15 +93,23 @@ RefinementStage& add_refinement_stage(Simulation& sim, const RefinementSettings&
   return ref;
 }
 
-std::size_t refine_all(Simulation& sim, Pattern pattern, double rsp_k) {
+template <int D>
+std::size_t refine_all(SimulationT<D>& sim, Pattern pattern, double rsp_k) {
   std::vector<std::uint8_t> marks(sim.store().size(), 1);
   return split_with(sim, marks, pattern, rsp_k, std::numeric_limits<int>::max());
 }
 
-std::size_t refine_region(Simulation& sim, const Box2& box, Pattern pattern, double rsp_k) {
-  std::vector<std::uint8_t> marks(sim.store().size(), 0);
-  ZoneCriterion(box).mark(sim.store(), marks);
+template <int D>
+std::size_t refine_region(SimulationT<D>& sim, const Box<D>& box, Pattern pattern, double rsp_k) {
+  const auto& s = sim.store();
+  std::vector<std::uint8_t> marks(s.size(), 0);
+  for (std::size_t i = 0; i < s.size(); ++i) marks[i] = s.kind[i] == Kind::fluid && box.contains(s.x[i]) ? 1 : 0;
   return split_with(sim, marks, pattern, rsp_k, std::numeric_limits<int>::max());
 }
+
+template std::size_t refine_all<2>(SimulationT<2>&, Pattern, double);
+template std::size_t refine_all<3>(SimulationT<3>&, Pattern, double);
+template std::size_t refine_region<2>(SimulationT<2>&, const Box<2>&, Pattern, double);
+template std::size_t refine_region<3>(SimulationT<3>&, const Box<3>&, Pattern, double);
 
 }  // namespace sph::refine

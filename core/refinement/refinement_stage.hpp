@@ -51,8 +51,10 @@ class RefinementStage final : public Stage {
 RefinementStage& add_refinement_stage(Simulation& sim, const RefinementSettings& settings);
 
 /// Static refinement at set-up: splits every fluid particle (fully refined runs) or those in a box, then
-/// refreshes the simulation. Returns how many were split.
-std::size_t refine_all(Simulation& sim, Pattern pattern, double rsp_k);
-std::size_t refine_region(Simulation& sim, const Box2& box, Pattern pattern, double rsp_k);
+/// refreshes the simulation. Returns how many were split. (2D and 3D.)
+template <int D>
+std::size_t refine_all(SimulationT<D>& sim, Pattern pattern, double rsp_k);
+template <int D>
+std::size_t refine_region(SimulationT<D>& sim, const Box<D>& box, Pattern pattern, double rsp_k);
 
 }  // namespace sph::refine

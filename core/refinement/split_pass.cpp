@@ -11,8 +11,10 @@
 
 namespace sph::refine {
 
-SplitResult split_marked(ParticleStore<2>& store, const std::vector<std::uint8_t>& marks, Pattern pattern,
-                         double rsp_k, int max_level, const std::vector<Wall2>& walls, double time) {
+template <int D>
+SplitResult split_marked(ParticleStore<D>& store, const std::vector<std::uint8_t>& marks, Pattern pattern,
+                         double rsp_k, int max_level, const std::vector<Wall<D>>& walls, double time) {
+  constexpr unsigned children = kChildren<D>;
   const std::size_t n = store.size();
   auto splits = [&](std::size_t i) {
     return marks[i] != 0 && store.kind[i] == Kind::fluid && store.level[i] < max_level;
@@ -32,20 +34,20 @@ SplitResult split_marked(ParticleStore<2>& store, const std::vector<std::uint8_t
   }
   for (const std::uint32_t i : split_index) {  // a daughter's id must hold its generation and its path
     const ParticleId id = store.id[i];
-    if (generation(id) >= kMaxGenerations || path(id) > (kPathMask >> 2)) {
+    if (!has_room_for_daughters<D>(id)) {
       throw std::length_error("split: particle id " + std::to_string(id) + " has no room for a daughter's id (" +
-                              std::to_string(kMaxGenerations) + " generations at most)");
+                              std::to_string(kMaxGenerationsIn<D>) + " generations at most)");
     }
   }
-  std::vector<Offsets> offsets(count);
+  std::vector<OffsetsIn<D>> offsets(count);
   std::vector<std::uint8_t> shifted(count, 0);
   {
-    std::optional<NeighbourQuery> query;
+    std::optional<NeighbourQueryIn<D>> query;
     if (pattern == Pattern::rsp) query.emplace(store);
     par::parallel_for(count, [&](std::size_t r) {
       const std::size_t i = split_index[r];
-      Offsets o = pattern == Pattern::aap
-                      ? axis_aligned_pattern(store.d[i])
+      OffsetsIn<D> o = pattern == Pattern::aap
+                      ? axis_aligned_pattern<D>(store.d[i])
                       : rotated_scaled_pattern(store.d[i], find_reference(store, *query, i), rsp_k);
       shifted[r] = keep_inside_walls(store.x[i], o, walls, 0.25 * (0.5 * store.d[i])) ? 1 : 0;
       offsets[r] = o;
@@ -58,7 +60,7 @@ SplitResult split_marked(ParticleStore<2>& store, const std::vector<std::uint8_t
       n,
       [&](std::size_t i) -> std::uint32_t {
         if (store.kind[i] == Kind::ghost) return 0;
-        return splits(i) ? 4u : 1u;
+        return splits(i) ? children : 1u;
       },
       &out_offsets);
   store.gather(src);
@@ -66,23 +68,29 @@ SplitResult split_marked(ParticleStore<2>& store, const std::vector<std::uint8_t
   par::parallel_for(count, [&](std::size_t r) {
     const std::size_t i = split_index[r];  // index before the gather
     const std::size_t first = out_offsets[i];
-    const Vec<2> xi = s.x[first];
-    const double m = 0.25 * s.m[first], h = 0.5 * s.h[first], d = 0.5 * s.d[first];
+    const Vec<D> xi = s.x[first];
+    // 1 / 2^D is exact, so m / 2^D is m times it (0.25 m in 2D, as the paper's m/4).
+    const double m = (1.0 / static_cast<double>(children)) * s.m[first], h = 0.5 * s.h[first], d = 0.5 * s.d[first];
     const std::int32_t level = s.level[first] + 1;
     const ParticleId parent = s.id[first];
-    for (std::size_t a = 0; a < 4; ++a) {
+    for (std::size_t a = 0; a < children; ++a) {
       const std::size_t k = first + a;
       s.x[k] = xi + offsets[r][a];
       s.m[k] = m;
       s.h[k] = h;
       s.d[k] = d;
       s.level[k] = level;
-      s.id[k] = daughter_id(parent, static_cast<unsigned>(a));
+      s.id[k] = daughter_id<D>(parent, static_cast<unsigned>(a));
       s.level_time[k] = time;
       s.origin[k] = Origin::split;
     }
   });
   return result;
 }
+
+template SplitResult split_marked<2>(ParticleStore<2>&, const std::vector<std::uint8_t>&, Pattern, double, int,
+                                     const std::vector<Wall<2>>&, double);
+template SplitResult split_marked<3>(ParticleStore<3>&, const std::vector<std::uint8_t>&, Pattern, double, int,
+                                     const std::vector<Wall<3>>&, double);
 
 }  // namespace sph::refine

@@ -1,5 +1,5 @@
 #pragma once
-// The split pass between steps (section 3.2): mark -> count (1 or 4; ghosts 0, they are rebuilt) ->
+// The split pass between steps (section 3.2): mark -> count (1 or 2^D; ghosts 0, they are rebuilt) ->
 // exclusive scan -> one gather of every field through the store's registry -> daughters written in place.
 // The new particle order is fixed by the scan and the new ids by the parents' ids, so the result is the same
 // at any thread count and whichever criterion marked.
@@ -17,11 +17,13 @@ struct SplitResult {
   std::size_t shifted = 0;  // patterns shifted inward by the wall rule (centroid moved)
 };
 
-/// Splits every fluid particle with marks[i] != 0 and level < max_level into four daughters placed by
-/// `pattern`, keeping them inside `walls`. marks has store.size() entries. Daughter a of the particle with id
-/// P gets id daughter_id(P, a) (core/refinement/family.hpp) and level_time = `time`.
-/// Throws std::length_error when a daughter's generation would not fit in its id (kMaxGenerations).
-SplitResult split_marked(ParticleStore<2>& store, const std::vector<std::uint8_t>& marks, Pattern pattern,
-                         double rsp_k, int max_level, const std::vector<Wall2>& walls, double time = 0.0);
+/// Splits every fluid particle with marks[i] != 0 and level < max_level into 2^D daughters (four in 2D, eight in
+/// 3D) of mass m / 2^D, smoothing length h / 2 and spacing d / 2, placed by `pattern`, keeping them inside
+/// `walls`. marks has store.size() entries. Daughter a of the particle with id P gets id daughter_id<D>(P, a)
+/// (core/refinement/family.hpp) and level_time = `time`.
+/// Throws std::length_error when a daughter's generation would not fit in its id (kMaxGenerationsIn<D>).
+template <int D>
+SplitResult split_marked(ParticleStore<D>& store, const std::vector<std::uint8_t>& marks, Pattern pattern,
+                         double rsp_k, int max_level, const std::vector<Wall<D>>& walls, double time = 0.0);
 
 }  // namespace sph::refine
