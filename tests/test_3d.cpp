@@ -11,8 +11,10 @@
 
 #include "core/boundary/ghosts.hpp"
 #include "core/boundary/wall.hpp"
+#include "core/boundary/wall_particles.hpp"
 #include "core/case_builder.hpp"
 #include "core/refinement/family.hpp"
+#include "core/refinement/merge_pass.hpp"
 #include "core/refinement/patterns.hpp"
 #include "core/refinement/refinement_stage.hpp"
 #include "core/refinement/split_pass.hpp"
@@ -431,6 +433,96 @@ TEST(Refinement3D, RotatedPatternPointsAnAxisAtTheReferenceAndScalesByF) {
   const auto aap = sph::refine::axis_aligned_pattern<3>(0.1);
   for (const Vec3& a : aap)
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(std::abs(a[k]), 0.025, 1e-17);
+}
+
+TEST(Refinement3D, SplitThenMergeGivesBackTheLattice) {
+  sph::Tank3Spec spec;
+  spec.length = 0.4;
+  spec.width = 0.3;
+  spec.depth = 0.2;
+  sph::SimulationT<3> sim = sph::make_still_tank(spec);
+  sim.remove_ghosts();
+  const sph::ParticleStore<3> before = sim.store();
+  sph::refine::refine_all(sim, sph::refine::Pattern::aap, 1.0);
+  sim.remove_ghosts();
+  auto& s = sim.store();
+  ASSERT_EQ(s.size(), 8 * before.size());
+  // Perturb nothing: every family sits as the split left it, so every one merges (the lattice's outer layer is
+  // d/2 from the walls, where the merge rule allows a particle of spacing d).
+  std::vector<std::uint8_t> may(s.size(), 1);
+  const auto r = sph::refine::merge_families<3>(s, may, sim.settings().geometry, 0.0);
+  EXPECT_EQ(r.merged, before.size());
+  EXPECT_EQ(r.kept_off_walls + r.kept_dispersed + r.kept_by_criterion, 0u);
+  ASSERT_EQ(s.size(), before.size());
+  const auto ia = sph::test::index_by_id(before), ib = sph::test::index_by_id(s);
+  for (std::size_t id = 0; id < ia.size(); ++id) {
+    if (ia[id] == static_cast<std::size_t>(-1)) continue;
+    ASSERT_NE(ib[id], static_cast<std::size_t>(-1)) << "the merged particle takes its parent's id back";
+    const std::size_t i = ia[id], j = ib[id];
+    // The mass-weighted mean of eight offsets +-d/4 about x: x up to the rounding of those sums.
+    EXPECT_LE((s.x[j] - before.x[i]).norm(), 1e-12 * before.x[i].norm()) << id;
+    EXPECT_NEAR(s.m[j], before.m[i], 1e-12 * before.m[i]);
+    EXPECT_NEAR(s.rho[j], before.rho[i], 1e-12 * before.rho[i]);
+    EXPECT_EQ(s.h[j], before.h[i]);
+    EXPECT_EQ(s.d[j], before.d[i]);
+    EXPECT_EQ(s.level[j], 0);
+  }
+}
+
+/// A small 3D breaking dam (a 0.2 x 0.3 x 0.3 m column in a 0.6 x 0.3 x 0.5 m open box, d = 0.05 m) with dynamic
+/// AAP refinement above 1 m/s and coarsening below 0.5 m/s.
+sph::SimulationT<3> small_dam_break(sph::TimeStepping stepping) {
+  sph::SolverSettingsT<3> st;
+  st.eos.rho0 = 1000.0;
+  st.eos.c0 = 10.0 * std::sqrt(2.0 * kG * 0.3);
+  st.geometry.container = {Vec3(0, 0, 0), Vec3(0.6, 0.3, 0.5)};
+  st.stepping = stepping;
+  // As the 2D dam break: Lennard-Jones wall particles (D = 5 g H, at half the finest spacing) beside the ghosts,
+  // which alone do not stop a fast fine particle (their repulsion vanishes as it nears its image).
+  st.lennard_jones = sph::LennardJonesSettings{5.0 * kG * 0.3, 0.5, 0.0125};
+  sph::SimulationT<3> sim(st);
+  sph::add_wall_particles(sim.store(), st.geometry.walls(), 0.0125, st.eos.rho0);
+  sph::FluidBlockSpecT<3> block;
+  block.spacing = 0.05;
+  sph::add_fluid(sim.store(), sph::lattice_box(Vec3(0, 0, 0), Vec3(0.2, 0.3, 0.3), 0.05), block, st.eos.rho0);
+  sph::set_hydrostatic(sim.store(), 0, sim.store().size(), 0.3, kG, st.eos);
+  sim.refresh();
+  sph::refine::RefinementSettings rs;
+  rs.v_threshold = 1.0;
+  rs.check_interval = 10;
+  rs.max_level = 1;
+  rs.coarsening = sph::refine::CoarseningSettings{0.5, 16, 0.05};
+  sph::refine::add_refinement_stage(sim, rs);
+  return sim;
+}
+
+TEST(Refinement3D, DynamicDamBreakRefinesConservesMassAndIsThreadIndependent) {
+  for (const auto stepping : {sph::TimeStepping::global, sph::TimeStepping::per_level}) {
+    std::vector<sph::ParticleStore<3>> ends;
+    std::vector<sph::DiagnosticsT<3>> diags;
+    for (const int threads : {1, 2}) {
+      ThreadCount tc(threads);
+      sph::SimulationT<3> sim = small_dam_break(stepping);
+      const double m0 = sim.diagnostics().mass;
+      sim.run_until(0.25);  // the front reaches the far wall (0.6 m) at about t = 0.2 s
+      const auto d = sim.diagnostics();
+      SCOPED_TRACE(testing::Message() << "threads " << threads << ", per level " << (stepping == sph::TimeStepping::per_level)
+                                      << ": " << d.fluid << " fluid, per level " << d.per_level.size());
+      EXPECT_EQ(d.mass, m0) << "splits give m/8 exactly and the diagnostics' mass is a compensated sum";
+      ASSERT_GE(d.per_level.size(), 2u);
+      EXPECT_GT(d.per_level[1], 100u) << "the fast front is refined";
+      sim.remove_ghosts();
+      ends.push_back(sim.store());
+      diags.push_back(d);
+    }
+    ASSERT_EQ(ends[0].size(), ends[1].size());
+    for (std::size_t i = 0; i < ends[0].size(); ++i) {
+      ASSERT_EQ(ends[0].id[i], ends[1].id[i]) << i;
+      EXPECT_EQ(ends[0].x[i], ends[1].x[i]) << i;
+      EXPECT_EQ(ends[0].v[i], ends[1].v[i]) << i;
+    }
+    EXPECT_EQ(diags[0].total_energy(), diags[1].total_energy());
+  }
 }
 
 }  // namespace

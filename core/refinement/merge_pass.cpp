@@ -10,12 +10,11 @@ namespace sph::refine {
 
 namespace {
 
-double cross(const Vec<2>& a, const Vec<2>& b) { return a[0] * b[1] - a[1] * b[0]; }
-
 /// True when x is in the fluid domain and at least `margin` from every wall it projects onto.
-bool clear_of_walls(const Vec<2>& x, const Geometry2& geometry, const std::vector<Wall2>& walls, double margin) {
+template <int D>
+bool clear_of_walls(const Vec<D>& x, const Geometry<D>& geometry, const std::vector<Wall<D>>& walls, double margin) {
   if (!geometry.in_fluid_domain(x)) return false;
-  for (const Wall2& w : walls) {
+  for (const Wall<D>& w : walls) {
     const double dist = w.signed_distance(x);
     if (dist > -margin && dist < margin && w.projects_onto(x, margin)) return false;
   }
@@ -28,51 +27,56 @@ struct Candidate {
   std::uint32_t index;
 };
 
+template <int D>
 struct FamilyOutcome {
-  std::array<std::uint32_t, 4> members{};  // store indices in sibling order
+  std::array<std::uint32_t, kChildren<D>> members{};  // store indices in sibling order
   std::uint32_t keeper = 0;                // the lowest store index: the merged particle goes there
   int verdict = 0;                         // 0 merged, 1 off walls, 2 would split again, 3 dispersed
-  double d_kinetic = 0.0, d_angular = 0.0;
+  double d_kinetic = 0.0;
+  Angular<D> d_angular = zero_angular<D>();
   // The merged state.
-  Vec<2> x = Vec<2>::Zero(), v = Vec<2>::Zero(), vh = Vec<2>::Zero();
+  Vec<D> x = Vec<D>::Zero(), v = Vec<D>::Zero(), vh = Vec<D>::Zero();
   double m = 0, rho = 0, rhoh = 0;
 };
 
 }  // namespace
 
-MergeResult merge_families(ParticleStore<2>& store, const std::vector<std::uint8_t>& may_merge,
-                           const Geometry2& geometry, double time,
-                           const std::function<bool(const Vec<2>&, const Vec<2>&)>& would_split) {
-  MergeResult result;
+template <int D>
+MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::uint8_t>& may_merge,
+                                const Geometry<D>& geometry, double time,
+                                const std::function<bool(const Vec<D>&, const Vec<D>&)>& would_split) {
+  constexpr unsigned children = kChildren<D>;
+  MergeResultIn<D> result;
   const std::size_t n = store.size();
   std::vector<Candidate> cand;
   for (std::size_t i = 0; i < n; ++i) {
     if (!may_merge[i] || store.kind[i] != Kind::fluid || !has_parent(store.id[i])) continue;
-    cand.push_back({parent_id(store.id[i]), sibling_index(store.id[i]), static_cast<std::uint32_t>(i)});
+    cand.push_back({parent_id<D>(store.id[i]), sibling_index<D>(store.id[i]), static_cast<std::uint32_t>(i)});
   }
   // (parent, sibling) is unique among live particles, so the sorted order is fixed by the data.
   std::sort(cand.begin(), cand.end(), [](const Candidate& a, const Candidate& b) {
     return a.parent != b.parent ? a.parent < b.parent : a.sibling < b.sibling;
   });
-  std::vector<FamilyOutcome> fam;
-  for (std::size_t k = 0; k + 3 < cand.size();) {
-    if (cand[k + 3].parent != cand[k].parent) {
+  std::vector<FamilyOutcome<D>> fam;
+  for (std::size_t k = 0; k + (children - 1) < cand.size();) {
+    if (cand[k + (children - 1)].parent != cand[k].parent) {
       ++k;
       continue;
     }
-    FamilyOutcome f;
-    for (unsigned a = 0; a < 4; ++a) f.members[a] = cand[k + a].index;
+    FamilyOutcome<D> f;
+    for (unsigned a = 0; a < children; ++a) f.members[a] = cand[k + a].index;
     f.keeper = *std::min_element(f.members.begin(), f.members.end());
     fam.push_back(f);
-    k += 4;
+    k += children;
   }
   if (fam.empty()) return result;
 
-  const std::vector<Wall2> walls = geometry.walls();
+  const std::vector<Wall<D>> walls = geometry.walls();
   par::parallel_for(fam.size(), [&](std::size_t r) {
-    FamilyOutcome& f = fam[r];
-    double m = 0.0, vol = 0.0, volh = 0.0, ke = 0.0, lz = 0.0;
-    Vec<2> mx = Vec<2>::Zero(), mv = Vec<2>::Zero(), mvh = Vec<2>::Zero();
+    FamilyOutcome<D>& f = fam[r];
+    double m = 0.0, vol = 0.0, volh = 0.0, ke = 0.0;
+    Angular<D> lz = zero_angular<D>();
+    Vec<D> mx = Vec<D>::Zero(), mv = Vec<D>::Zero(), mvh = Vec<D>::Zero();
     for (const std::uint32_t i : f.members) {  // sibling order: a fixed summation order
       const double mi = store.m[i];
       m += mi;
@@ -82,7 +86,7 @@ MergeResult merge_families(ParticleStore<2>& store, const std::vector<std::uint8
       vol += mi / store.rho[i];
       volh += mi / store.rhoh[i];
       ke += 0.5 * mi * store.v[i].squaredNorm();
-      lz += mi * cross(store.x[i], store.v[i]);
+      lz += mi * cross<D>(store.x[i], store.v[i]);
     }
     f.m = m;
     f.x = mx / m;
@@ -106,11 +110,11 @@ MergeResult merge_families(ParticleStore<2>& store, const std::vector<std::uint8
       f.verdict = 2;
     }
     f.d_kinetic = 0.5 * m * f.v.squaredNorm() - ke;
-    f.d_angular = m * cross(f.x, f.v) - lz;
+    f.d_angular = m * cross<D>(f.x, f.v) - lz;
   });
 
   std::vector<std::uint8_t> drop(n, 0);
-  for (const FamilyOutcome& f : fam) {  // serial, in family order: the reported sums are deterministic
+  for (const FamilyOutcome<D>& f : fam) {  // serial, in family order: the reported sums are deterministic
     if (f.verdict == 1) {
       ++result.kept_off_walls;
       continue;
@@ -132,7 +136,7 @@ MergeResult merge_families(ParticleStore<2>& store, const std::vector<std::uint8
 
   auto s = store.view();
   par::parallel_for(fam.size(), [&](std::size_t r) {
-    const FamilyOutcome& f = fam[r];
+    const FamilyOutcome<D>& f = fam[r];
     if (f.verdict != 0) return;
     const std::size_t k = f.keeper;
     const ParticleId child = s.id[f.members[0]];
@@ -145,7 +149,7 @@ MergeResult merge_families(ParticleStore<2>& store, const std::vector<std::uint8
     s.h[k] = 2.0 * s.h[f.members[0]];  // powers of two: the parent's h and d exactly
     s.d[k] = 2.0 * s.d[f.members[0]];
     s.level[k] = s.level[f.members[0]] - 1;
-    s.id[k] = parent_id(child);
+    s.id[k] = parent_id<D>(child);
     s.level_time[k] = time;
     s.origin[k] = Origin::fresh_merge;
     s.a[k].setZero();  // the rates are re-evaluated after the pass
@@ -157,5 +161,10 @@ MergeResult merge_families(ParticleStore<2>& store, const std::vector<std::uint8
   store.compact([&](std::size_t i) { return drop[i] == 0 && store.kind[i] != Kind::ghost; });
   return result;
 }
+
+template MergeResultIn<2> merge_families<2>(ParticleStore<2>&, const std::vector<std::uint8_t>&, const Geometry<2>&,
+                                            double, const std::function<bool(const Vec<2>&, const Vec<2>&)>&);
+template MergeResultIn<3> merge_families<3>(ParticleStore<3>&, const std::vector<std::uint8_t>&, const Geometry<3>&,
+                                            double, const std::function<bool(const Vec<3>&, const Vec<3>&)>&);
 
 }  // namespace sph::refine

@@ -1,7 +1,7 @@
 #pragma once
-// The merge pass between steps (coarsening, the inverse of the split pass): the four daughters of one parent
-// become one particle again when all four may merge. Families are found through the ids
-// (core/refinement/family.hpp): candidates sorted by parent id, four consecutive with one parent form a family.
+// The merge pass between steps (coarsening, the inverse of the split pass): the 2^D daughters of one parent
+// (four in 2D, eight in 3D) become one particle again when all may merge. Families are found through the ids
+// (core/refinement/family.hpp): candidates sorted by parent id, 2^D consecutive with one parent form a family.
 // The merged particle takes the parent's id, level, spacing and smoothing length back, and sits where the
 // lowest store index of the family sat; the three others leave by one stream compaction. The order of the
 // store and every sum (sibling order) are fixed by the data, so the result is the same at any thread count.
@@ -16,28 +16,32 @@
 #include <vector>
 
 #include "core/boundary/wall.hpp"
+#include "core/diagnostics.hpp"
 #include "core/particle_store.hpp"
 
 namespace sph::refine {
 
-struct MergeResult {
-  std::size_t merged = 0;            // families merged (each four particles into one)
+template <int D>
+struct MergeResultIn {
+  std::size_t merged = 0;            // families merged (each 2^D particles into one)
   std::size_t kept_off_walls = 0;    // complete families left alone: their centre of mass was too close to a wall
   std::size_t kept_by_criterion = 0; // complete families left alone: the merged particle would be split again
   std::size_t kept_dispersed = 0;    // complete families left alone: a member is outside the merged particle's square
-  double d_kinetic = 0.0;            // kinetic energy after - before (J/m), <= 0
-  double d_angular = 0.0;            // angular momentum L_z after - before (kg m^2/s per m)
+  double d_kinetic = 0.0;            // kinetic energy after - before (J/m in 2D, J in 3D), <= 0
+  Angular<D> d_angular = zero_angular<D>();  // angular momentum after - before (2D: L_z)
 };
+using MergeResult = MergeResultIn<2>;
 
-/// Merges every family whose four members are fluid and have may_merge[i] != 0 (may_merge has store.size()
-/// entries). A family is left alone when a member lies outside the square of side d (the merged spacing)
+/// Merges every family whose 2^D members are fluid and have may_merge[i] != 0 (may_merge has store.size()
+/// entries). A family is left alone when a member lies outside the square (cube) of side d (the merged spacing)
 /// centred on the family's centre of mass (the family has dispersed: the merged particle would land among
 /// others), when that centre is outside the fluid domain or closer to a wall than d / 2 (where the set-up
 /// puts a particle of spacing d, and where the Lennard-Jones wall force of such a particle begins), or when
 /// `would_split(X, V)` says the merged particle would be marked for a split at once. `time` is written as
 /// the merged particle's level_time.
-MergeResult merge_families(ParticleStore<2>& store, const std::vector<std::uint8_t>& may_merge,
-                           const Geometry2& geometry, double time,
-                           const std::function<bool(const Vec<2>&, const Vec<2>&)>& would_split = {});
+template <int D>
+MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::uint8_t>& may_merge,
+                                const Geometry<D>& geometry, double time,
+                                const std::function<bool(const Vec<D>&, const Vec<D>&)>& would_split = {});
 
 }  // namespace sph::refine

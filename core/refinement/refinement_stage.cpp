@@ -6,7 +6,8 @@ namespace sph::refine {
 
 namespace {
 
-std::vector<std::size_t> level_counts(const ParticleStore<2>& store) {
+template <int D>
+std::vector<std::size_t> level_counts(const ParticleStore<D>& store) {
   std::vector<std::size_t> per_level;
   for (std::size_t i = 0; i < store.size(); ++i) {
     if (store.kind[i] != Kind::fluid) continue;
@@ -28,16 +29,18 @@ std::size_t split_with(SimulationT<D>& sim, std::vector<std::uint8_t>& marks, Pa
 
 }  // namespace
 
-RefinementStage::RefinementStage(const RefinementSettings& settings)
-    : settings_(settings), criterion_(make_criterion(settings)) {}
+template <int D>
+RefinementStageIn<D>::RefinementStageIn(const RefinementSettings& settings)
+    : settings_(settings), criterion_(make_criterion<D>(settings)) {}
 
-bool RefinementStage::after_step(Simulation& sim) {
+template <int D>
+bool RefinementStageIn<D>::after_step(SimulationT<D>& sim) {
   // Every check_interval steps of the finest bin: a check after the step in which their count passed a multiple
   // of the interval (with one global step, every check_interval-th step).
   const auto interval = static_cast<std::uint64_t>(std::max(1, settings_.check_interval));
   const std::uint64_t fine = sim.fine_step_count();
   if ((fine - static_cast<std::uint64_t>(sim.last_substeps())) / interval == fine / interval) return false;
-  ParticleStore<2>& store = sim.store();
+  ParticleStore<D>& store = sim.store();
   std::vector<std::uint8_t> marks(store.size(), 0);
   criterion_->mark(store, marks);
   if (settings_.coarsening) {
@@ -54,7 +57,7 @@ bool RefinementStage::after_step(Simulation& sim) {
   for (std::size_t i = 0; i < store.size() && !any; ++i) {
     any = marks[i] && store.kind[i] == Kind::fluid && store.level[i] < settings_.max_level;
   }
-  PassRecord rec;
+  PassRecordIn<D> rec;
   rec.step = sim.step_count();
   rec.time = sim.time();
   if (any) {
@@ -72,8 +75,8 @@ bool RefinementStage::after_step(Simulation& sim) {
     for (std::size_t i = 0; i < store.size(); ++i) {
       if (may[i] && store.level_time[i] > held_since) may[i] = 0;
     }
-    const MergeResult m = merge_families(store, may, sim.settings().geometry, sim.time(),
-                                         [&](const Vec<2>& x, const Vec<2>& v) { return criterion_->would_split(x, v); });
+    const MergeResultIn<D> m = merge_families<D>(store, may, sim.settings().geometry, sim.time(),
+                                         [&](const Vec<D>& x, const Vec<D>& v) { return criterion_->would_split(x, v); });
     rec.merged = m.merged;
     rec.merge_d_kinetic = m.d_kinetic;
     rec.merge_d_angular = m.d_angular;
@@ -86,9 +89,10 @@ bool RefinementStage::after_step(Simulation& sim) {
   return true;
 }
 
-RefinementStage& add_refinement_stage(Simulation& sim, const RefinementSettings& settings) {
-  auto stage = std::make_unique<RefinementStage>(settings);
-  RefinementStage& ref = *stage;
+template <int D>
+RefinementStageIn<D>& add_refinement_stage(SimulationT<D>& sim, const RefinementSettings& settings) {
+  auto stage = std::make_unique<RefinementStageIn<D>>(settings);
+  RefinementStageIn<D>& ref = *stage;
   sim.add_stage(std::move(stage));
   return ref;
 }
@@ -107,6 +111,10 @@ std::size_t refine_region(SimulationT<D>& sim, const Box<D>& box, Pattern patter
   return split_with(sim, marks, pattern, rsp_k, std::numeric_limits<int>::max());
 }
 
+template class RefinementStageIn<2>;
+template class RefinementStageIn<3>;
+template RefinementStageIn<2>& add_refinement_stage<2>(SimulationT<2>&, const RefinementSettings&);
+template RefinementStageIn<3>& add_refinement_stage<3>(SimulationT<3>&, const RefinementSettings&);
 template std::size_t refine_all<2>(SimulationT<2>&, Pattern, double);
 template std::size_t refine_all<3>(SimulationT<3>&, Pattern, double);
 template std::size_t refine_region<2>(SimulationT<2>&, const Box<2>&, Pattern, double);

@@ -17,38 +17,44 @@
 namespace sph::refine {
 
 /// One line of the refinement log: what a pass did.
-struct PassRecord {
+template <int D>
+struct PassRecordIn {
   std::uint64_t step = 0;
   double time = 0.0;
   std::size_t refined = 0;
   std::size_t shifted = 0;
-  std::size_t merged = 0;     // families merged (four into one)
-  double merge_d_kinetic = 0.0;  // kinetic energy the merges removed (J/m, <= 0)
-  double merge_d_angular = 0.0;  // change of L_z by the merges
+  std::size_t merged = 0;     // families merged (2^D into one)
+  double merge_d_kinetic = 0.0;  // kinetic energy the merges removed (J/m in 2D, J in 3D; <= 0)
+  Angular<D> merge_d_angular = zero_angular<D>();  // change of angular momentum by the merges (2D: L_z)
   std::vector<std::size_t> per_level;  // fluid particles per level after the pass
 };
+using PassRecord = PassRecordIn<2>;
 
-class RefinementStage final : public Stage {
+template <int D>
+class RefinementStageIn final : public StageT<D> {
  public:
-  explicit RefinementStage(const RefinementSettings& settings);
+  explicit RefinementStageIn(const RefinementSettings& settings);
   const char* name() const override { return "refinement"; }
-  bool after_step(Simulation& sim) override;
+  bool after_step(SimulationT<D>& sim) override;
 
   const RefinementSettings& settings() const { return settings_; }
-  const std::vector<PassRecord>& log() const { return log_; }
+  const std::vector<PassRecordIn<D>>& log() const { return log_; }
   std::size_t total_refined() const { return total_; }
   std::size_t total_merged() const { return total_merged_; }
 
  private:
   RefinementSettings settings_;
-  std::unique_ptr<Criterion> criterion_;
-  std::vector<PassRecord> log_;
+  std::unique_ptr<CriterionIn<D>> criterion_;
+  std::vector<PassRecordIn<D>> log_;
   std::size_t total_ = 0;
   std::size_t total_merged_ = 0;
 };
 
+using RefinementStage = RefinementStageIn<2>;
+
 /// Adds dynamic refinement to a simulation; returns the stage (owned by the simulation) for its log.
-RefinementStage& add_refinement_stage(Simulation& sim, const RefinementSettings& settings);
+template <int D>
+RefinementStageIn<D>& add_refinement_stage(SimulationT<D>& sim, const RefinementSettings& settings);
 
 /// Static refinement at set-up: splits every fluid particle (fully refined runs) or those in a box, then
 /// refreshes the simulation. Returns how many were split. (2D and 3D.)
