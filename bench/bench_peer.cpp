@@ -71,6 +71,60 @@ void peer_args(benchmark::internal::Benchmark* b) {
 BENCHMARK(BM_Peer_DamBreak)->Apply(peer_args)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true)
     ->Unit(benchmark::kSecond)->UseRealTime();
 
+// DualSPHysics' own 3D dam break, its example CaseDambreak (../shared/ANCHORS.md): a 0.4 x 0.67 x 0.3 m block
+// of water at the end of a 1.6 x 0.67 x 0.4 m tank, a 0.12 x 0.12 x 0.45 m column at x = 0.9 m, y = 0.24 m;
+// h = sqrt(3) dp (its coefh = 1) or our default 1.2 dp; c0 = 20 sqrt(g H); density diffusion 0.1; artificial
+// viscosity 0.02; from rest over its windows. Walls: ghosts and Lennard-Jones particles at dp / 2, as our 2D
+// dam break. Args: {dp index 0..2, threads, h/d x 1000}.
+struct Peer3Case {
+  double dp;
+  double window;
+};
+constexpr Peer3Case kCases3[] = {{0.0135, 0.05}, {0.0085, 0.01}, {0.005, 0.001}};
+
+void BM_Peer_DamBreak3D(benchmark::State& state) {
+  const Peer3Case c = kCases3[state.range(0)];
+  omp_set_num_threads(static_cast<int>(state.range(1)));
+  DamBreak3Spec spec;
+  spec.spacing = c.dp;
+  spec.h_factor = static_cast<double>(state.range(2)) / 1000.0;
+  std::uint64_t steps = 0;
+  std::size_t fluid = 0, walls = 0;
+  double pairs = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    SimulationT<3> sim = make_dam_break(spec);
+    const auto d = sim.diagnostics();
+    fluid = d.fluid;
+    walls = d.walls;
+    pairs = 0;
+    state.ResumeTiming();
+    while (sim.time() < c.window) {
+      const StepInfo info = sim.step(c.window - sim.time());
+      pairs += static_cast<double>(info.limits.pairs);
+    }
+    steps = sim.step_count();
+  }
+  state.counters["fluid"] = static_cast<double>(fluid);
+  state.counters["walls"] = static_cast<double>(walls);
+  state.counters["steps"] = static_cast<double>(steps);
+  state.counters["particle_steps_per_s"] =
+      benchmark::Counter(static_cast<double>(fluid * steps) * static_cast<double>(state.iterations()),
+                         benchmark::Counter::kIsRate);
+  state.counters["pairs_per_s"] =
+      benchmark::Counter(pairs * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["pairs_per_particle"] = pairs / static_cast<double>(fluid * steps);
+}
+
+void peer3_args(benchmark::internal::Benchmark* b) {
+  for (int64_t k : {0, 1, 2})
+    for (int64_t t : {1, 2})
+      for (int64_t hf : {1732, 1200}) b->Args({k, t, hf});
+}
+
+BENCHMARK(BM_Peer_DamBreak3D)->Apply(peer3_args)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true)
+    ->Unit(benchmark::kSecond)->UseRealTime();
+
 }  // namespace
 
 BENCHMARK_MAIN();

@@ -66,6 +66,45 @@ void BM_Sweep_Viscosity(benchmark::State& s) { BM_Sweep_Effects(s, true, false);
 void BM_Sweep_LennardJones(benchmark::State& s) { BM_Sweep_Effects(s, false, true); }
 void BM_Sweep_ViscosityAndLennardJones(benchmark::State& s) { BM_Sweep_Effects(s, true, true); }
 
+// A still tank in 2D and 3D at N fluid particles (h = 1.2 d, ghost walls): the cost of a step per particle and per
+// pair interaction, for the dimensions' ratio (issue #18: at most 1.5x per pair) and for how the 3D step scales
+// with N (flat within 20 % from 1e4 to 1e6).
+template <int D>
+SimulationT<D> tank(std::size_t n);
+
+template <>
+SimulationT<2> tank<2>(std::size_t n) {
+  TankSpec spec;  // 25 m x 10 m
+  spec.spacing = std::sqrt(spec.width * spec.depth / static_cast<double>(n));
+  return make_still_tank(spec);
+}
+
+template <>
+SimulationT<3> tank<3>(std::size_t n) {
+  Tank3Spec spec;  // 1 m x 0.4 m x 0.5 m of water
+  spec.spacing = std::cbrt(spec.length * spec.width * spec.depth / static_cast<double>(n));
+  return make_still_tank(spec);
+}
+
+template <int D>
+void BM_Step_Tank(benchmark::State& state) {
+  omp_set_num_threads(static_cast<int>(state.range(1)));
+  SimulationT<D> sim = tank<D>(static_cast<std::size_t>(state.range(0)));
+  const std::size_t fluid = sim.diagnostics().fluid;
+  for (int k = 0; k < 3; ++k) sim.step();
+  double pairs = 0.0;
+  for (auto _ : state) pairs += static_cast<double>(sim.step().limits.pairs);
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * fluid));
+  state.counters["fluid"] = static_cast<double>(fluid);
+  state.counters["pairs_per_particle"] = pairs / static_cast<double>(fluid * state.iterations());
+  state.counters["pairs_per_s"] = benchmark::Counter(pairs, benchmark::Counter::kIsRate);
+}
+
+BENCHMARK_TEMPLATE(BM_Step_Tank, 2)->Args({10000, 1})->Args({100000, 1})->Args({1000000, 1})
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_Step_Tank, 3)->Args({10000, 1})->Args({100000, 1})->Args({1000000, 1})
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+
 void sizes(benchmark::internal::Benchmark* b) {
   for (int64_t n : {1000, 10000, 100000, 1000000, 4000000})
     for (int64_t t : {1, 2}) b->Args({n, t});

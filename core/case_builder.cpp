@@ -72,6 +72,28 @@ SimulationT<3> make_still_tank(const Tank3Spec& spec) {
   return sim;
 }
 
+SimulationT<3> make_dam_break(const DamBreak3Spec& spec) {
+  SolverSettingsT<3> s;
+  s.eos.rho0 = 1000.0;
+  const double H = spec.water[2];
+  s.eos.c0 = spec.coef_sound * std::sqrt(kG * H);
+  s.viscosity = ViscositySettings{spec.alpha, 0.0};
+  if (spec.density_diffusion) s.density_diffusion = DensityDiffusionSettings{0.1};
+  s.geometry.container = {Vec<3>::Zero(), spec.tank};
+  s.geometry.obstacles.push_back({spec.column_lo, spec.column_hi});
+  const double wall_spacing = 0.5 * spec.spacing;
+  s.lennard_jones = LennardJonesSettings{5.0 * kG * H, 0.5, wall_spacing};
+  SimulationT<3> sim(s);
+  FluidBlockSpecT<3> block;
+  block.spacing = spec.spacing;
+  block.h_factor = spec.h_factor;
+  add_fluid(sim.store(), lattice_box(Vec<3>::Zero(), spec.water, spec.spacing), block, s.eos.rho0);
+  set_hydrostatic(sim.store(), 0, sim.store().size(), H, kG, s.eos);
+  add_wall_particles(sim.store(), s.geometry.walls(), wall_spacing, s.eos.rho0);
+  sim.refresh();
+  return sim;
+}
+
 Simulation make_dam_break(const DamBreakSpec& spec) {
   SolverSettings s;
   s.eos.rho0 = 1000.0;

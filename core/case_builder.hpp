@@ -52,6 +52,20 @@ struct DamBreakSpec {
   bool viscosity = true;
 };
 
+/// DualSPHysics' 3D dam break (its example CaseDambreak): a block of water at the start of a box tank, a square
+/// column standing in its path. Ghost walls (free-slip) and Lennard-Jones wall particles at half the spacing.
+struct DamBreak3Spec {
+  Vec<3> tank = Vec<3>(1.6, 0.67, 0.4);
+  Vec<3> water = Vec<3>(0.4, 0.67, 0.3);  // from the origin corner
+  Vec<3> column_lo = Vec<3>(0.9, 0.24, 0.0);
+  Vec<3> column_hi = Vec<3>(1.02, 0.36, 0.45);
+  double spacing = 0.0085;
+  double h_factor = 1.7320508075688772;  // sqrt(3), its coefh = 1
+  double coef_sound = 20.0;              // c0 = coef_sound sqrt(g H), H the water's height
+  double alpha = 0.02;
+  bool density_diffusion = true;         // delta = 0.1
+};
+
 struct DropSpec {
   double width = 25.0;  // container x in [-width/2, width/2]
   double depth = 10.0;
@@ -79,6 +93,8 @@ Simulation make_still_tank(const TankSpec& spec);
 SimulationT<3> make_still_tank(const Tank3Spec& spec);
 /// The paper's breaking dam: square column against the left wall, gravity, free-slip walls.
 Simulation make_dam_break(const DamBreakSpec& spec);
+/// DualSPHysics' 3D dam break.
+SimulationT<3> make_dam_break(const DamBreak3Spec& spec);
 /// The paper's splash of a drop into a pool.
 Simulation make_drop(const DropSpec& spec);
 

@@ -525,4 +525,21 @@ TEST(Refinement3D, DynamicDamBreakRefinesConservesMassAndIsThreadIndependent) {
   }
 }
 
+TEST(DamBreak3D, PeerCaseRunsWithItsColumn) {
+  // DualSPHysics' CaseDambreak geometry at a coarse spacing (0.04 m: 10 x 16 x 7 fluid particles): the set-up is
+  // what the peer benchmark times (bench/bench_peer.cpp), and its first 0.1 s run without a failure.
+  sph::DamBreak3Spec spec;
+  spec.spacing = 0.04;
+  sph::SimulationT<3> sim = sph::make_dam_break(spec);
+  const auto d0 = sim.diagnostics();
+  EXPECT_EQ(d0.fluid, 10u * 16u * 7u);
+  EXPECT_GT(d0.walls, 0u);
+  EXPECT_EQ(sim.settings().geometry.walls().size(), 5u + 6u) << "the open tank and the column";
+  sim.run_until(0.1);
+  const auto d = sim.diagnostics();
+  EXPECT_EQ(d.mass, d0.mass);
+  EXPECT_GT(d.max_speed, 0.5) << "the column of water is collapsing (free fall over 0.1 s gives ~1 m/s)";
+  EXPECT_LT(d.max_density_error, 0.05);
+}
+
 }  // namespace
