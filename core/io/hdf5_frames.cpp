@@ -57,11 +57,11 @@ struct H5Traits<double> {
   static constexpr int components = 1;
   static FieldLayout layout(std::string n) { return {std::move(n), "Float", 8, 1}; }
 };
-template <>
-struct H5Traits<Vec<2>> {
+template <int D, int O, int R, int C>
+struct H5Traits<Eigen::Matrix<double, D, 1, O, R, C>> {
   static hid_t type() { return H5T_NATIVE_DOUBLE; }
-  static constexpr int components = 2;
-  static FieldLayout layout(std::string n) { return {std::move(n), "Float", 8, 2}; }
+  static constexpr int components = D;
+  static FieldLayout layout(std::string n) { return {std::move(n), "Float", 8, D}; }
 };
 template <>
 struct H5Traits<std::int32_t> {
@@ -158,7 +158,8 @@ void read_dataset(hid_t group, const std::string& name, std::vector<T>& values) 
   if (!values.empty()) check(H5Dread(set, Tr::type(), H5S_ALL, H5S_ALL, kDefault, values.data()), "read dataset " + name);
 }
 
-std::vector<std::size_t> non_ghosts(const ParticleStore<2>& store) {
+template <int D>
+std::vector<std::size_t> non_ghosts(const ParticleStore<D>& store) {
   std::vector<std::size_t> keep;
   keep.reserve(store.size());
   for (std::size_t i = 0; i < store.size(); ++i) {
@@ -180,9 +181,12 @@ bool wanted(const std::vector<std::string>& fields, std::string_view name) {
 
 }  // namespace
 
-std::vector<FieldLayout> field_layouts() {
+namespace {
+
+template <int D>
+std::vector<FieldLayout> layouts_in() {
   std::vector<FieldLayout> out;
-  const ParticleStore<2> store;
+  const ParticleStore<D> store;
   store.for_each_field([&](const auto& f) {
     using T = typename std::decay_t<decltype(f)>::value_type;
     out.push_back(H5Traits<T>::layout(std::string(f.name())));
@@ -190,7 +194,24 @@ std::vector<FieldLayout> field_layouts() {
   return out;
 }
 
-FrameHeader write_frame(const std::filesystem::path& file, const std::string& group, const ParticleStore<2>& store,
+/// The dimension of a frame or checkpoint group: the second extent of its position dataset.
+int group_dimension(hid_t group) {
+  const Handle set(H5Dopen2(group, "position", kDefault), H5Dclose, "open dataset position");
+  const Handle space(H5Dget_space(set), H5Sclose, "get the dataspace of position");
+  hsize_t dims[2] = {0, 0};
+  if (H5Sget_simple_extent_ndims(space) != 2 || H5Sget_simple_extent_dims(space, dims, nullptr) < 0 ||
+      (dims[1] != 2 && dims[1] != 3)) {
+    throw std::runtime_error("HDF5: dataset position is not N x 2 or N x 3");
+  }
+  return static_cast<int>(dims[1]);
+}
+
+}  // namespace
+
+std::vector<FieldLayout> field_layouts(int dimension) { return dimension == 3 ? layouts_in<3>() : layouts_in<2>(); }
+
+template <int D>
+FrameHeader write_frame(const std::filesystem::path& file, const std::string& group, const ParticleStore<D>& store,
                         double time, std::uint64_t step, std::uint64_t index, const std::vector<std::string>& fields) {
   quiet_hdf5();
   const std::vector<std::size_t> keep = non_ghosts(store);
@@ -225,7 +246,7 @@ FrameHeader read_frame_header(const std::filesystem::path& file, const std::stri
   h.step = read_attribute<std::uint64_t>(g, "step", H5T_NATIVE_UINT64);
   h.index = read_attribute<std::uint64_t>(g, "frame", H5T_NATIVE_UINT64);
   h.particles = read_attribute<std::uint64_t>(g, "particles", H5T_NATIVE_UINT64);
-  for (const FieldLayout& layout : field_layouts()) {
+  for (const FieldLayout& layout : field_layouts(group_dimension(g))) {
     if (H5Lexists(g, layout.name.c_str(), kDefault) > 0) h.fields.push_back(layout);
   }
   return h;
@@ -244,7 +265,8 @@ std::vector<double> read_frame_field(const std::filesystem::path& file, const st
   return values;
 }
 
-void write_checkpoint(const std::filesystem::path& file, const ParticleStore<2>& store, const CheckpointState& state) {
+template <int D>
+void write_checkpoint(const std::filesystem::path& file, const ParticleStore<D>& store, const CheckpointState& state) {
   quiet_hdf5();
   const std::vector<std::size_t> keep = non_ghosts(store);
   const std::filesystem::path tmp = temporary_path(file);
@@ -266,6 +288,8 @@ void write_checkpoint(const std::filesystem::path& file, const ParticleStore<2>&
     write_attribute(g, "initial_mass", H5T_NATIVE_DOUBLE, state.initial_mass);
     write_attribute(g, "initial_momentum_x", H5T_NATIVE_DOUBLE, state.initial_momentum_x);
     write_attribute(g, "initial_momentum_y", H5T_NATIVE_DOUBLE, state.initial_momentum_y);
+    if (D == 3) write_attribute(g, "initial_momentum_z", H5T_NATIVE_DOUBLE, state.initial_momentum_z);
+    write_attribute(g, "dimension", H5T_NATIVE_UINT64, static_cast<std::uint64_t>(D));
     write_attribute(g, "removed_particles", H5T_NATIVE_UINT64, state.removed_particles);
     write_attribute(g, "removed_mass", H5T_NATIVE_DOUBLE, state.removed_mass);
     write_attribute(g, "removed_mass_compensation", H5T_NATIVE_DOUBLE, state.removed_mass_compensation);
@@ -291,9 +315,21 @@ std::string checkpoint_problem(const std::filesystem::path& file) {
   return "";
 }
 
-CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore<2>& store) {
+int checkpoint_dimension(const std::filesystem::path& file) {
   if (const std::string why = checkpoint_problem(file); !why.empty()) {
     throw std::runtime_error(file.string() + " is not a sphrefine checkpoint (" + why + ")");
+  }
+  const Handle f(H5Fopen(file.c_str(), H5F_ACC_RDONLY, kDefault), H5Fclose, "open " + file.string());
+  const Handle g(H5Gopen2(f, kCheckpointGroup, kDefault), H5Gclose, "open the checkpoint group of " + file.string());
+  // Absent from checkpoints written before 3D: those are 2D.
+  return has_attribute(g, "dimension") ? static_cast<int>(read_attribute<std::uint64_t>(g, "dimension", H5T_NATIVE_UINT64)) : 2;
+}
+
+template <int D>
+CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore<D>& store) {
+  if (const int dim = checkpoint_dimension(file); dim != D) {
+    throw std::runtime_error(file.string() + " is a " + std::to_string(dim) + "D checkpoint; this run is " +
+                             std::to_string(D) + "D");
   }
   const Handle f(H5Fopen(file.c_str(), H5F_ACC_RDONLY, kDefault), H5Fclose, "open " + file.string());
   const Handle g(H5Gopen2(f, kCheckpointGroup, kDefault), H5Gclose, "open the checkpoint group of " + file.string());
@@ -312,6 +348,7 @@ CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore
   s.initial_mass = read_attribute<double>(g, "initial_mass", H5T_NATIVE_DOUBLE);
   s.initial_momentum_x = read_attribute<double>(g, "initial_momentum_x", H5T_NATIVE_DOUBLE);
   s.initial_momentum_y = read_attribute<double>(g, "initial_momentum_y", H5T_NATIVE_DOUBLE);
+  if (D == 3) s.initial_momentum_z = read_attribute<double>(g, "initial_momentum_z", H5T_NATIVE_DOUBLE);
   // Absent from checkpoints written before outflow removal existed: nothing was removed then.
   if (has_attribute(g, "removed_particles")) {
     s.removed_particles = read_attribute<std::uint64_t>(g, "removed_particles", H5T_NATIVE_UINT64);
@@ -328,5 +365,14 @@ CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore
   store.set_next_id(s.next_id);
   return s;
 }
+
+template FrameHeader write_frame<2>(const std::filesystem::path&, const std::string&, const ParticleStore<2>&, double,
+                                    std::uint64_t, std::uint64_t, const std::vector<std::string>&);
+template FrameHeader write_frame<3>(const std::filesystem::path&, const std::string&, const ParticleStore<3>&, double,
+                                    std::uint64_t, std::uint64_t, const std::vector<std::string>&);
+template void write_checkpoint<2>(const std::filesystem::path&, const ParticleStore<2>&, const CheckpointState&);
+template void write_checkpoint<3>(const std::filesystem::path&, const ParticleStore<3>&, const CheckpointState&);
+template CheckpointState read_checkpoint<2>(const std::filesystem::path&, ParticleStore<2>&);
+template CheckpointState read_checkpoint<3>(const std::filesystem::path&, ParticleStore<3>&);
 
 }  // namespace sph::io

@@ -2,7 +2,7 @@
 // HDF5 frames and checkpoints, written through the store's field registry so that no field is forgotten.
 //
 // A frame file holds one group (named like "frame_000012") with one dataset per particle field (named
-// after the field: "position" N x 2, "density" N, "level" N, ...) for every particle except ghosts, in
+// after the field: "position" N x D (D = 2 or 3), "density" N, "level" N, ...) for every particle except ghosts, in
 // store order, each with a `units` attribute (the field's unit, ParticleStore), and the attributes time,
 // time_units ("s"), step, frame and particles. A checkpoint file holds group "checkpoint" with every field
 // (with units too) and the whole state needed to continue bitwise identically. Every file
@@ -34,18 +34,19 @@ struct FrameHeader {
   std::vector<FieldLayout> fields;
 };
 
-/// The layout of every field of the store (in registry order).
-std::vector<FieldLayout> field_layouts();
+/// The layout of every field of a D-dimensional store (in registry order).
+std::vector<FieldLayout> field_layouts(int dimension = 2);
 
 /// Writes the named fields (every field when empty; "position" always) of every non-ghost particle to a new
 /// HDF5 file, atomically. Returns what it wrote.
-FrameHeader write_frame(const std::filesystem::path& file, const std::string& group, const ParticleStore<2>& store,
+template <int D>
+FrameHeader write_frame(const std::filesystem::path& file, const std::string& group, const ParticleStore<D>& store,
                         double time, std::uint64_t step, std::uint64_t index, const std::vector<std::string>& fields);
 
-/// The attributes and the datasets of a frame group.
+/// The attributes and the datasets of a frame group (its dimension read from the position dataset).
 FrameHeader read_frame_header(const std::filesystem::path& file, const std::string& group);
 
-/// Reads one field of a frame: doubles (position and velocity come as x0, y0, x1, y1, ...).
+/// Reads one field of a frame: doubles (position and velocity come as x0, y0, [z0,] x1, y1, ...).
 std::vector<double> read_frame_field(const std::filesystem::path& file, const std::string& group, const std::string& field);
 
 /// Everything a checkpoint restores besides the particles.
@@ -63,6 +64,7 @@ struct CheckpointState {
   double initial_mass = 0.0;      // the run's state at t = 0, for the drift in the summary
   double initial_momentum_x = 0.0;
   double initial_momentum_y = 0.0;
+  double initial_momentum_z = 0.0;  // 3D only
   std::uint64_t removed_particles = 0;     // fluid removed through the open top so far (Simulation::removed)
   double removed_mass = 0.0;               // its mass: the compensated sum's value and compensation, so a
   double removed_mass_compensation = 0.0;  // resumed run adds later removals exactly as the uninterrupted one
@@ -70,13 +72,19 @@ struct CheckpointState {
 };
 
 /// Writes every field of every non-ghost particle and the state, atomically.
-void write_checkpoint(const std::filesystem::path& file, const ParticleStore<2>& store, const CheckpointState& state);
+template <int D>
+void write_checkpoint(const std::filesystem::path& file, const ParticleStore<D>& store, const CheckpointState& state);
 
 /// Why `file` is not a checkpoint this program reads ("" when it is one: an HDF5 file with the checkpoint
 /// group in the current format). Reads only the file's header.
 std::string checkpoint_problem(const std::filesystem::path& file);
 
-/// Reads a checkpoint into `store` (replacing its particles and next id). Throws std::runtime_error.
-CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore<2>& store);
+/// The dimension a checkpoint was written in (2 for checkpoints older than 3D).
+int checkpoint_dimension(const std::filesystem::path& file);
+
+/// Reads a checkpoint into `store` (replacing its particles and next id). Throws std::runtime_error, also when
+/// the checkpoint was written in another dimension.
+template <int D>
+CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore<D>& store);
 
 }  // namespace sph::io

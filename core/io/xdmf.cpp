@@ -34,7 +34,7 @@ std::string xdmf_document(const std::vector<XdmfEntry>& frames) {
         << "        <Topology TopologyType=\"Polyvertex\" Dimensions=\"" << e.frame.particles << "\"/>\n";
     for (const FieldLayout& f : e.frame.fields) {
       if (f.name != "position") continue;
-      out << "        <Geometry GeometryType=\"XY\">\n";
+      out << "        <Geometry GeometryType=\"" << (f.components == 3 ? "XYZ" : "XY") << "\">\n";
       data_item(out, e, f, "          ");
       out << "        </Geometry>\n";
     }

@@ -43,7 +43,8 @@ class TempFolder {
   fs::path path_;
 };
 
-inline void expect_bitwise_equal(const ParticleStore<2>& a, const ParticleStore<2>& b) {
+template <int D>
+void expect_bitwise_equal(const ParticleStore<D>& a, const ParticleStore<D>& b) {
   ASSERT_EQ(a.size(), b.size());
   EXPECT_EQ(a.next_id(), b.next_id());
   std::vector<std::vector<unsigned char>> fa, fb;
