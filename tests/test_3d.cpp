@@ -16,6 +16,7 @@
 #include "core/io/hdf5_frames.hpp"
 #include "core/io/xdmf.hpp"
 #include "core/refinement/family.hpp"
+#include "core/scene/probes.hpp"
 #include "core/refinement/merge_pass.hpp"
 #include "core/refinement/patterns.hpp"
 #include "core/refinement/refinement_stage.hpp"
@@ -613,6 +614,24 @@ TEST(Io3D, CheckpointResumesBitwiseAndRefusesTheOtherDimension) {
   sph::test::expect_bitwise_equal(a.store(), b.store());
   sph::ParticleStore<2> flat;
   EXPECT_THROW(sph::io::read_checkpoint(file, flat), std::runtime_error);
+}
+
+TEST(Probes3D, GaugeIsAVerticalLineAndSensorAPointOnAWall) {
+  const sph::Tank3Spec spec;  // 0.5 m of water at rest, d = 0.05 m
+  const sph::SimulationT<3> sim = sph::make_still_tank(spec);
+  const auto& s = sim.store();
+  // A lattice column's top edge is the water's depth exactly, anywhere in the tank; outside it the column is dry.
+  using H = sph::scene::Horizontal<3>;
+  EXPECT_NEAR(sph::scene::water_height<3>(s, H(0.5, 0.2), spec.spacing, 0.0, spec.spacing), spec.depth, 1e-12);
+  EXPECT_NEAR(sph::scene::water_height<3>(s, H(0.02, 0.38), spec.spacing, 0.0, spec.spacing), spec.depth, 1e-12);
+  EXPECT_EQ(sph::scene::water_height<3>(s, H(1.5, 0.2), spec.spacing, 0.0, spec.spacing), 0.0);
+  // A sensor on the side wall x = 0 at mid-depth reads the hydrostatic pressure there: the lattice (and its ghosts
+  // beyond the wall, which carry the same pressure) sits symmetrically about the point, so the Shepard
+  // interpolation of the linear field p = rho0 g (H - z) is exact but for the weights' volumes m / rho, which vary
+  // with depth by g (2 h) / c0^2 = 2.4e-3 across the kernel; the error is at most that share of p's variation
+  // across the kernel, rho0 g 2 h = 0.48 of p here: 1.2e-3 of p. The bound is 2e-3.
+  const double p = sph::scene::point_pressure<3>(s, Vec3(0.0, 0.2, 0.25));
+  EXPECT_NEAR(p, 1000.0 * kG * 0.25, 2e-3 * 1000.0 * kG * 0.25);
 }
 
 }  // namespace

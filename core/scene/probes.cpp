@@ -40,24 +40,38 @@ double layered_top(std::vector<std::pair<double, double>>& v, double gap, double
   return result;
 }
 
-/// The top y + d/2 of the water in the column |x_i - x| <= band, or -infinity when the column is dry: a
-/// layer above a gap counts when it is at least two gaps thick, so a wave that plunges over an air cavity is
-/// measured at its crest, as a wave gauge sees it, while a few isolated splash particles above the surface are
-/// not.
-double column_top(const ParticleStore<2>& store, double x, double band, double gap) {
+/// The top (last coordinate) + d/2 of the water in the vertical column within `band` of `at` along every
+/// horizontal axis (2D: |x_i - x| <= band; 3D: a square column about the line at (x, y)), or -infinity when the
+/// column is dry: a layer above a gap counts when it is at least two gaps thick, so a wave that plunges over an
+/// air cavity is measured at its crest, as a wave gauge sees it, while a few isolated splash particles above the
+/// surface are not.
+template <int D>
+double column_top(const ParticleStore<D>& store, const Horizontal<D>& at, double band, double gap) {
   std::vector<std::pair<double, double>> v;
   for (std::size_t i = 0; i < store.size(); ++i) {
-    if (store.kind[i] != Kind::fluid || std::abs(store.x[i][0] - x) > band) continue;
-    v.emplace_back(store.x[i][1], 0.5 * store.d[i]);
+    if (store.kind[i] != Kind::fluid) continue;
+    bool inside = true;
+    for (int a = 0; a < D - 1; ++a) inside = inside && std::abs(store.x[i][a] - at[a]) <= band;
+    if (!inside) continue;
+    v.emplace_back(store.x[i][D - 1], 0.5 * store.d[i]);
   }
   return layered_top(v, gap, 2.0 * gap);
 }
 
+double column_top(const ParticleStore<2>& store, double x, double band, double gap) {
+  return column_top<2>(store, Horizontal<2>::Constant(x), band, gap);
+}
+
 }  // namespace
 
-double water_height(const ParticleStore<2>& store, double x, double band, double floor, double gap) {
-  const double top = column_top(store, x, band, gap);
+template <int D>
+double water_height(const ParticleStore<D>& store, const Horizontal<D>& at, double band, double floor, double gap) {
+  const double top = column_top<D>(store, at, band, gap);
   return std::isfinite(top) ? top - floor : 0.0;
+}
+
+double water_height(const ParticleStore<2>& store, double x, double band, double floor, double gap) {
+  return water_height<2>(store, Horizontal<2>::Constant(x), band, floor, gap);
 }
 
 double surge_front(const ParticleStore<2>& store, double origin, double gap) {
@@ -69,13 +83,14 @@ double surge_front(const ParticleStore<2>& store, double origin, double gap) {
   return std::isfinite(front) ? front - origin : 0.0;
 }
 
-double point_pressure(const ParticleStore<2>& store, const Vec<2>& point) {
+template <int D>
+double point_pressure(const ParticleStore<D>& store, const Vec<D>& point) {
   double num = 0.0, den = 0.0;
   for (std::size_t i = 0; i < store.size(); ++i) {
     if (store.kind[i] == Kind::wall || !(store.rho[i] > 0.0)) continue;
     const double r = (store.x[i] - point).norm();
     if (r >= 2.0 * store.h[i]) continue;
-    const double w = store.m[i] / store.rho[i] * CubicSpline<2>::value(r, store.h[i]);
+    const double w = store.m[i] / store.rho[i] * CubicSpline<D>::value(r, store.h[i]);
     num += w * store.p[i];
     den += w;
   }
@@ -115,5 +130,10 @@ std::vector<double> Probes::measure(const ParticleStore<2>& store) const {
   }
   return out;
 }
+
+template double water_height<2>(const ParticleStore<2>&, const Horizontal<2>&, double, double, double);
+template double water_height<3>(const ParticleStore<3>&, const Horizontal<3>&, double, double, double);
+template double point_pressure<2>(const ParticleStore<2>&, const Vec<2>&);
+template double point_pressure<3>(const ParticleStore<3>&, const Vec<3>&);
 
 }  // namespace sph::scene

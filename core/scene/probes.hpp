@@ -22,9 +22,19 @@
 
 namespace sph::scene {
 
+/// A point in the horizontal plane: x in 2D, (x, y) in 3D.
+template <int D>
+using Horizontal = Vec<D - 1>;
+
+/// The water height at a gauge: the column's top minus `floor` (0 when dry). In 3D a gauge is the vertical line
+/// at (x, y), sampled over the square column of half-width `band` about it.
+template <int D>
+double water_height(const ParticleStore<D>& store, const Horizontal<D>& at, double band, double floor, double gap);
 double water_height(const ParticleStore<2>& store, double x, double band, double floor, double gap);
 double surge_front(const ParticleStore<2>& store, double origin, double gap);
-double point_pressure(const ParticleStore<2>& store, const Vec<2>& point);
+/// The pressure at a point (a sensor on a wall: the ghosts across the wall take part), in 2D or 3D.
+template <int D>
+double point_pressure(const ParticleStore<D>& store, const Vec<D>& point);
 
 class Probes {
  public:
