@@ -23,6 +23,8 @@ BEGIN, END = "<!-- bench:begin (scripts/bench, tools/performance_report.py) -->"
 # ../shared/ANCHORS.md: DualSPHysics 5.4 (OpenMP CPU build) on this kind of 2-core machine, fluid
 # particle-steps per second, median of 5 runs, its own 2D dam break at three resolutions.
 PEER = {0: (4050, 1.30e6, 2.34e6), 1: (29768, 1.52e6, 2.75e6), 2: (250632, 1.54e6, 2.87e6)}
+# ../shared/ANCHORS.md, DualSPHysics' 3D CaseDambreak: fluid particle-steps/s at 1 and 2 threads per dp index.
+PEER3D = {0: (1.96e5, 3.81e5), 1: (2.00e5, 3.94e5), 2: (2.13e5, 4.20e5)}
 
 
 def load(results):
@@ -287,6 +289,64 @@ def main():
                "like the peer's; its figures are `../shared/ANCHORS.md`'s (medians of 5). Target 1.5x.", ""]
         md += table(["fluid particles", "h/d", "threads", "sphrefine", "DualSPHysics", "ratio", "pairs/particle",
                      "steps"], rows)
+        md += [""]
+
+    if runs.get("dims"):
+        # BM_Step_Tank<D>/N/threads: the still tank in 2D and 3D; the cost per pair and per particle-step.
+        by = {}
+        for b in runs["dims"]:
+            name = b["name"]
+            dim = 3 if "<3>" in name else 2
+            a = args_of(name.split(">", 1)[1])
+            by[(dim, a[0], a[1])] = b
+        rows = []
+        for (dim, n, t) in sorted(by):
+            b = by[(dim, n, t)]
+            ns_pair = 1e9 / b["pairs_per_s"]
+            other = by.get((2, n, t))
+            ratio = "%.2f" % (ns_pair / (1e9 / other["pairs_per_s"])) if dim == 3 and other else ""
+            rows.append([dim, fmt_count(n), fmt_count(b["fluid"]), t, "%.3g" % ms(b), "%.3g" % b["items_per_second"],
+                         "%.3f" % (1e6 / b["items_per_second"]), "%.1f" % b["pairs_per_particle"], "%.1f" % ns_pair,
+                         ratio])
+        md += ["### 2D and 3D: the cost of a pair and of a particle-step (`sph_bench_step`, BM_Step_Tank)", "",
+               "The still tank (2D: 25 m x 10 m; 3D: 1 m x 0.4 m x 0.5 m of water) at N fluid particles, h = 1.2 d, ghost "
+               "walls, viscosity; `sim.step()` repeated. ns/pair is the step's wall time over the pair interactions it "
+               "evaluated (each side of a pair counted). Targets (issue #18): 3D per pair at most 1.5x 2D; 3D per "
+               "particle-step flat within 20 % from 1e4 to 1e6.", ""]
+        md += table(["D", "N", "fluid", "threads", "ms/step", "particle-steps/s", "us/particle-step", "pairs/particle",
+                     "ns/pair", "3D / 2D per pair"], rows)
+        ref = [1e6 / by[(3, n, 1)]["items_per_second"] for n in sorted({k[1] for k in by}) if (3, n, 1) in by]
+        if ref:
+            mid = sum(ref) / len(ref)
+            md += ["", "3D time per particle-step, 1 thread, %s-%s: mean %.3f us, largest deviation %.0f %% (target +-20 %%)."
+                   % (fmt_count(min(k[1] for k in by)), fmt_count(max(k[1] for k in by)), mid,
+                      100 * max(abs(r / mid - 1) for r in ref))]
+        md += [""]
+
+    if runs.get("peer3d"):
+        rows = []
+        for b in runs["peer3d"]:
+            a = args_of(b["name"])
+            if len(a) < 3:
+                continue
+            p1, p2 = PEER3D[a[0]]
+            ours = b["particle_steps_per_s"]
+            theirs = p1 if a[1] == 1 else p2
+            rows.append([int(b["fluid"]), int(b["walls"]), "%.3f" % (a[2] / 1000), a[1], "%.3g" % ours, "%.3g" % theirs,
+                         "%.2fx" % (ours / theirs), "%.3g" % b["pairs_per_s"], "%.1f" % b["pairs_per_particle"],
+                         "%d" % b["steps"]])
+        rows.sort(key=lambda r: (r[0], r[2], r[3]))
+        for r in rows:
+            r[0] = fmt_count(r[0])
+            r[1] = fmt_count(r[1])
+        md += ["### The peer in 3D: DualSPHysics' CaseDambreak (`sph_bench_peer`, BM_Peer_DamBreak3D)", "",
+               "Its 3D dam break (a 0.4 x 0.67 x 0.3 m block, a 1.6 x 0.67 x 0.4 m tank, a 0.12 x 0.12 x 0.45 m column) "
+               "from rest over its windows, whole solver run, no output, density diffusion 0.1, c0 = 20 sqrt(g H); ours "
+               "with ghost walls and Lennard-Jones wall particles at dp / 2 (the walls column), at its h = sqrt(3) dp and "
+               "at our default 1.2 dp. Its figures are `../shared/ANCHORS.md`'s (its fluid counts 30,624 / 128,310 / "
+               "638,400; medians of 3), measured on another day: the ratio is indicative.", ""]
+        md += table(["fluid particles", "wall particles", "h/d", "threads", "sphrefine", "DualSPHysics", "ratio",
+                     "pairs/s", "pairs/particle", "steps"], rows)
         md += [""]
 
     if runs.get("busy"):
