@@ -287,7 +287,9 @@ Effects parse_effects(const Json& j, const std::string& path) {
     e.ghost_walls = r.choice<Slip>("ghost_walls", {{"free-slip", Slip::free_slip}, {"no-slip", Slip::no_slip}}, std::nullopt);
   }
   if (r.has("ghost_pressure")) {
-    e.ghost_pressure_mirrored = r.choice<bool>("ghost_pressure", {{"hydrostatic", false}, {"mirrored", true}}, false);
+    e.ghost_pressure = r.choice<GhostPressure>(
+        "ghost_pressure", {{"hydrostatic", GhostPressure::hydrostatic}, {"mirrored", GhostPressure::mirrored}},
+        GhostPressure::hydrostatic);
   }
   if (r.has("refinement")) e.refinement = parse_refinement(r.at("refinement"), r.path("refinement"));
   if (r.has("static_refinement")) {

@@ -66,7 +66,7 @@ Json scene_to_json(const Scene& s) {
     e["lennard_jones_wall"] = w;
   }
   if (fx.ghost_walls) e["ghost_walls"] = to_string(*fx.ghost_walls);
-  e["ghost_pressure"] = fx.ghost_pressure_mirrored ? "mirrored" : "hydrostatic";
+  e["ghost_pressure"] = to_string(fx.ghost_pressure);
   if (fx.refinement) {
     const Refinement& r = *fx.refinement;
     Json o;
@@ -99,7 +99,7 @@ Json scene_to_json(const Scene& s) {
   Json t{{"end", s.time.end}, {"cfl", s.time.cfl}};
   if (s.time.output_interval) t["output_interval"] = *s.time.output_interval;
   t["dt_max"] = s.time.dt_max;
-  t["stepping"] = s.time.stepping == TimeStepping::global ? "global" : "per_level";
+  t["stepping"] = to_string(s.time.stepping);
   j["time"] = t;
 
   if (!s.probes.empty()) {
