@@ -40,7 +40,7 @@ double distance_to_rect(const Vec<2>& p, const Rect& r) {
 }
 
 constexpr double kTol = 1e-9;
-constexpr int kMaxLevel = 8;
+using detail::kMaxLevel;
 constexpr double kMaxParticles = 5.0e7;
 
 bool inside(const Rect& inner, const Rect& outer) {
