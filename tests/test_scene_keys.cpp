@@ -1,10 +1,13 @@
 // The scene key registry (core/scene/scene_keys.hpp): each key declared once, its default inside its own range,
-// its variants named by its object's discriminator, the enumerations' names in one table each, and the key
-// tables written between a Markdown file's markers.
+// its variants named by its object's discriminator, the enumerations' names in one table each, and
+// docs/SCENES.md's key tables exactly what the registry produces.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -14,6 +17,15 @@
 namespace {
 
 using namespace sph::scene;
+
+const std::filesystem::path kRoot = std::filesystem::path(__FILE__).parent_path().parent_path();
+
+std::string read_text(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
 
 TEST(SceneKeys, EveryPathIsDeclaredOnce) {
   const auto keys = all_keys();
@@ -137,6 +149,13 @@ TEST(SceneKeys, RangesWordTheirRule) {
   EXPECT_TRUE(Range::non_negative().contains(0.0));
   EXPECT_FALSE(Range::positive().contains(0.0));
   EXPECT_FALSE(Range::between(1, 8).contains(9.0));
+}
+
+TEST(SceneKeys, ScenesMdTablesMatchTheRegistry) {
+  const std::string doc = read_text(kRoot / "docs" / "SCENES.md");
+  ASSERT_FALSE(doc.empty());
+  EXPECT_TRUE(doc == sync_key_tables(doc))
+      << "docs/SCENES.md's key tables differ from the registry: run 'sphrefine keys --sync docs/SCENES.md'";
 }
 
 TEST(SceneKeys, SyncReplacesOnlyTheTablesAndRefusesUnknownOrMissingMarkers) {
