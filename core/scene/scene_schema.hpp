@@ -377,5 +377,9 @@ namespace sph::scene::schema {
 
 /// The registry's root: the scene file's top-level object, bound to Scene (scene_keys.cpp).
 const Section<Scene>& scene_section();
+/// A box {lo, hi}: obstacles, refinement zones, static refinement's box (scene_keys.cpp).
+const Section<Rect>& box_section();
+/// The effects object (scene_keys_effects.cpp).
+const Section<Effects>& effects_section();
 
 }  // namespace sph::scene::schema
