@@ -1,5 +1,5 @@
 #pragma once
-// The program's commands, thin over core/: run, validate, info. Each returns the process exit code:
+// The program's commands, thin over core/: run, validate, info, keys. Each returns the process exit code:
 //   0 success, 1 the run failed (diverged, I/O), 2 a scene or command-line error (nothing created),
 //   3 the output folder already holds a run (use --force).
 #include <optional>
@@ -33,5 +33,14 @@ std::string checkpoint_every_option_error(const std::string& value);
 int run_command(const RunArguments& args);
 int validate_command(const std::string& scene, const std::vector<std::string>& overrides);
 int info_command();
+
+struct KeysArguments {
+  bool markdown = false;  // the tables of docs/SCENES.md instead of the list
+  std::string file;       // a Markdown file whose tables to rewrite (--sync) or compare (--check)
+  bool check = false;     // with a file: exit 1 when its tables differ, change nothing
+};
+/// The scene key registry: every key path with its type, default and range; or its Markdown tables; or a file's
+/// tables rewritten or checked (exit 1 when they differ).
+int keys_command(const KeysArguments& args);
 
 }  // namespace sph::app

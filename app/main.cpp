@@ -3,6 +3,7 @@
 //                       [--checkpoint-every T] [--resume CHECKPOINT] [--quiet]
 //   sphrefine validate SCENE [--set key.path=value ...]
 //   sphrefine info
+//   sphrefine keys [--markdown | --sync FILE | --check FILE]
 #include <CLI/CLI.hpp>
 
 #include "app/commands.hpp"
@@ -41,6 +42,16 @@ int main(int argc, char** argv) {
 
   CLI::App* info_cmd = app.add_subcommand("info", "Version, build type, threads and library versions");
 
+  sph::app::KeysArguments keys;
+  std::string keys_check;
+  CLI::App* keys_cmd = app.add_subcommand("keys", "Every scene key: path, type, unit, default, range (docs/SCENES.md)");
+  auto* markdown_opt =
+      keys_cmd->add_flag("--markdown", keys.markdown, "The key tables of docs/SCENES.md, each between its markers");
+  auto* sync_opt = keys_cmd->add_option("--sync", keys.file, "Rewrite the key tables between the markers of this file");
+  auto* check_opt = keys_cmd->add_option("--check", keys_check, "Exit 1 when this file's key tables differ from the registry");
+  sync_opt->excludes(check_opt);
+  markdown_opt->excludes(sync_opt)->excludes(check_opt);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -50,5 +61,9 @@ int main(int argc, char** argv) {
   if (run_cmd->parsed()) return sph::app::run_command(run);
   if (validate_cmd->parsed()) return sph::app::validate_command(validate_scene, validate_overrides);
   if (info_cmd->parsed()) return sph::app::info_command();
+  if (keys_cmd->parsed()) {
+    if (!keys_check.empty()) keys.file = keys_check, keys.check = true;
+    return sph::app::keys_command(keys);
+  }
   return sph::app::kExitUsage;
 }

@@ -143,6 +143,38 @@ TEST_F(Cli, ThreadsFollowTheWorkUnlessGiven) {
   EXPECT_NE(given.find("\"threads_rule\": \"as set\""), std::string::npos) << given;
 }
 
+TEST_F(Cli, KeysListsTheRegistryAndKeepsAMarkdownFileInStep) {
+  const Result list = run("keys");
+  EXPECT_EQ(list.code, 0) << list.err;
+  EXPECT_NE(list.out.find("time.cfl  number  default 0.2  0 < x <= 1\n"), std::string::npos) << list.out;
+  EXPECT_NE(list.out.find("fluid[i].radius  number (m)  required  > 0  for circle\n"), std::string::npos) << list.out;
+  const Result md = run("keys --markdown");
+  EXPECT_EQ(md.code, 0);
+  EXPECT_NE(md.out.find("<!-- keys: effects.refinement.coarsening -->\n| key | for |"), std::string::npos) << md.out;
+
+  // A file with a stale table: --check fails and changes nothing, --sync rewrites it, then --check passes.
+  const std::string all = md.out;
+  std::string stale = "# Scenes\n\nprose\n" + all;
+  const std::string good_table = "| `cfl` | number |";
+  const std::size_t at = stale.find(good_table);
+  ASSERT_NE(at, std::string::npos);
+  stale.replace(at, good_table.size(), "| `cfl` | string |");
+  write_scene("doc.md", stale);
+  const Result check = run("keys --check doc.md");
+  EXPECT_EQ(check.code, 1);
+  EXPECT_NE(check.err.find("doc.md: the key tables differ from the registry; run 'sphrefine keys --sync doc.md'"),
+            std::string::npos)
+      << check.err;
+  EXPECT_EQ(slurp(dir_ / "work" / "doc.md"), stale);
+  EXPECT_EQ(run("keys --sync doc.md").code, 0);
+  EXPECT_EQ(slurp(dir_ / "work" / "doc.md"), "# Scenes\n\nprose\n" + all);
+  EXPECT_EQ(run("keys --check doc.md").code, 0);
+  write_scene("unknown.md", "<!-- keys: tiem -->\n<!-- end keys -->\n");
+  const Result unknown = run("keys --check unknown.md");
+  EXPECT_EQ(unknown.code, 2);
+  EXPECT_NE(unknown.err.find("the marker names no scene object: 'tiem'"), std::string::npos) << unknown.err;
+}
+
 TEST_F(Cli, ValidateAGoodSceneWritesNothing) {
   write_scene("tiny.json", kTiny);
   const Result r = run("validate tiny.json");

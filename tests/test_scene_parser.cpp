@@ -2,10 +2,14 @@
 // and each kind of bad input is refused with one "scene error: <key.path>: <rule>" naming the key.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <filesystem>
 #include <string>
+#include <vector>
 
+#include "core/scene/scene_keys.hpp"
 #include "core/scene/scene_parser.hpp"
 
 namespace {
@@ -47,6 +51,13 @@ Json full_scene() {
     "output": { "folder": "out/full", "frames": true, "frame_interval": 0.5, "fields": ["position", "velocity"] }
   })",
                          "full_scene");
+}
+
+std::string detail_num(double x) {
+  std::ostringstream s;
+  s.precision(6);
+  s << x;
+  return s.str();
 }
 
 /// The SceneError a document raises ("" when it is accepted).
@@ -212,12 +223,12 @@ TEST(SceneParser, NonPhysicalValuesAreRefused) {
       {"/time/cfl", 2.0, "scene error: time.cfl: must be in (0, 1] (got 2)"},
       {"/h_factor", 0.1, "scene error: h_factor: must be between 0.5 and 3 (got 0.1)"},
       {"/fluid/1/radius", 0.0, "scene error: fluid[1].radius: must be positive (got 0)"},
-      {"/effects/artificial_viscosity/alpha", -0.1, "scene error: effects.artificial_viscosity.alpha: must not be negative"},
+      {"/effects/artificial_viscosity/alpha", -0.1, "scene error: effects.artificial_viscosity.alpha: must not be negative (got -0.1)"},
       {"/effects/artificial_stress/epsilon", 0.0, "scene error: effects.artificial_stress.epsilon: must be in (0, 1] (got 0)"},
       {"/effects/artificial_stress/exponent", 0, "scene error: effects.artificial_stress.exponent: must be between 1 and 16 (got 0)"},
       {"/effects/artificial_stress/exponent", 2.5, "scene error: effects.artificial_stress.exponent: must be an integer (got a number)"},
       {"/effects/density_diffusion/delta", -0.1, "scene error: effects.density_diffusion.delta: must be in (0, 1] (got -0.1)"},
-      {"/effects/refinement/check_interval", 0, "scene error: effects.refinement.check_interval: must be at least 1 step"},
+      {"/effects/refinement/check_interval", 0, "scene error: effects.refinement.check_interval: must be at least 1 (got 0)"},
       {"/time/dt_max", 1e-12, "scene error: time.dt_max: would take more than 1e9 steps to reach time.end"},
       {"/time/output_interval", 0.0, "scene error: time.output_interval: must be positive (got 0)"},
   };
@@ -229,6 +240,114 @@ TEST(SceneParser, NonPhysicalValuesAreRefused) {
   Json doc = full_scene();
   doc["material"] = Json{{"rho0", 1000}, {"c0", 0}};
   EXPECT_EQ(error_of(doc), "scene error: material.c0: must be positive (got 0)");
+}
+
+/// Scenes that together hold every ranged key: full_scene() and two variants with the keys it leaves out (the
+/// per-key ranges are checked before the rules across keys, so these need only parse).
+std::vector<Json> scenes_with_every_key() {
+  Json other = full_scene();
+  other["material"] = Json{{"rho0", 1000}, {"c0", 30}, {"reference_speed", 3}};
+  other["effects"]["lennard_jones_wall"] = Json{{"strength", 100}, {"spacing", 0.05}};
+  other["effects"]["refinement"] = Json{{"v_threshold", 5}, {"max_level", 2}, {"coarsening", Json{{"hold_time", 1}}}};
+  other["effects"]["static_refinement"] = Json{{"rsp_k", 1}};
+  Json few = full_scene();
+  few["effects"]["refinement"] = Json{{"criterion", "few_neighbours"}, {"min_neighbours", 6}, {"max_level", 2}};
+  return {full_scene(), other, few};
+}
+
+/// Every key the registry gives a range is refused just outside it, naming the key and the range: the
+/// validator's per-key checks come from the registry.
+TEST(SceneParser, EveryRangedKeyIsRefusedOutsideItsRange) {
+  int ranged = 0, tested = 0;
+  for (const KeyEntry& e : all_keys()) {
+    if (!e.key->range) continue;
+    ++ranged;
+    bool found = false;
+    for (const Json& base : scenes_with_every_key()) {
+      for (const char* index : {"0", "1", "2", "3"}) {
+        std::string path = e.path;
+        for (std::size_t at = path.find("[i]"); at != std::string::npos; at = path.find("[i]")) {
+          path.replace(at, 3, std::string("[") + index + "]");
+        }
+        std::string pointer = "/" + path;
+        for (char& c : pointer) c = (c == '.' || c == '[') ? '/' : c;
+        pointer.erase(std::remove(pointer.begin(), pointer.end(), ']'), pointer.end());
+        if (!base.contains(Json::json_pointer(pointer))) continue;
+        Json doc = base;
+        const Range& r = *e.key->range;
+        const double bad = r.has_lo ? (r.lo_open ? r.lo : r.lo - 1.0) : r.hi + 1.0;
+        if (e.key->type == KeyType::integer) {
+          doc[Json::json_pointer(pointer)] = static_cast<int>(bad);
+        } else {
+          doc[Json::json_pointer(pointer)] = bad;
+        }
+        EXPECT_EQ(error_of(doc), "scene error: " + path + ": " + r.rule() + " (got " + detail_num(bad) + ")");
+        found = true;
+        break;
+      }
+      if (found) break;
+    }
+    EXPECT_TRUE(found) << e.path << " is in none of the test scenes";
+    tested += found ? 1 : 0;
+  }
+  EXPECT_EQ(tested, ranged);
+  EXPECT_GE(ranged, 30);
+}
+
+TEST(SceneParser, MisplacedKeysNameWhatTheyAreAllowedFor) {
+  Json doc = full_scene();
+  doc["fluid"][0]["spacng"] = 0.5;
+  EXPECT_EQ(error_of(doc), "scene error: fluid[0].spacng: unknown key (did you mean 'spacing'?); allowed for a rectangle: "
+                           "shape, lo, hi, spacing, level, velocity, hydrostatic, surface");
+  doc = full_scene();
+  doc["probes"][3]["x"] = 1;
+  EXPECT_EQ(error_of(doc), "scene error: probes[3].x: unknown key; allowed for a pressure probe: type, name, position");
+  doc = full_scene();
+  doc["effects"]["refinement"]["coarsening"] = Json{{"min_neighbours", 20}};
+  EXPECT_EQ(error_of(doc), "scene error: effects.refinement.coarsening.min_neighbours: unknown key; allowed for criterion "
+                           "zone: hold_time");
+  doc = full_scene();
+  doc["effects"]["refinement"]["v_threshold"] = 3;
+  EXPECT_EQ(error_of(doc).rfind("scene error: effects.refinement.v_threshold: unknown key; allowed for criterion zone: ", 0),
+            0u)
+      << error_of(doc);
+  doc = full_scene();
+  doc["fluid"][1].erase("shape");
+  EXPECT_EQ(error_of(doc), "scene error: fluid[1].shape: missing required key (one of: rectangle, circle)");
+  doc = full_scene();
+  doc["time"]["stepping"] = "sometimes";
+  EXPECT_EQ(error_of(doc), "scene error: time.stepping: must be one of: global, per_level (got 'sometimes')");
+}
+
+TEST(SceneParser, CoarseningDefaultsFollowTheSplitTest) {
+  Json doc = full_scene();
+  doc["effects"]["refinement"] = Json{{"v_threshold", 8}, {"coarsening", Json::object()}, {"max_level", 2}};
+  Scene s = scene_from_json(doc);
+  ASSERT_TRUE(s.effects.refinement->coarsening);
+  EXPECT_EQ(s.effects.refinement->coarsening->v_threshold, 4.0);
+  EXPECT_EQ(s.effects.refinement->coarsening->hold_time, sph::refine::CoarseningSettings{}.hold_time);
+  EXPECT_EQ(scene_from_json(scene_to_json(s)), s);
+  doc["effects"]["refinement"] = Json{{"criterion", "few_neighbours"}, {"min_neighbours", 6}, {"coarsening", Json::object()},
+                                      {"max_level", 2}};
+  s = scene_from_json(doc);
+  EXPECT_EQ(s.effects.refinement->coarsening->min_neighbours, 12);
+  EXPECT_EQ(s.effects.refinement->coarsening->v_threshold, sph::refine::CoarseningSettings{}.v_threshold)
+      << "a key the criterion does not allow keeps the struct's value";
+  EXPECT_EQ(scene_from_json(scene_to_json(s)), s);
+}
+
+TEST(SceneParser, WriterWritesDefaultsAndLeavesAbsentKeysOut) {
+  Json doc = full_scene();
+  doc["effects"].erase("density_diffusion");
+  doc.erase("description");
+  const Json j = scene_to_json(scene_from_json(doc));
+  EXPECT_EQ(j.at("time").at("stepping"), "global");
+  EXPECT_EQ(j.at("effects").at("ghost_pressure"), "hydrostatic");
+  EXPECT_EQ(j.at("fluid")[1].at("hydrostatic"), false);
+  EXPECT_FALSE(j.at("effects").contains("density_diffusion"));
+  EXPECT_FALSE(j.contains("description"));
+  EXPECT_FALSE(j.at("fluid")[1].contains("lo")) << "a circle writes no rectangle keys";
+  EXPECT_FALSE(j.at("probes")[1].contains("origin") && !doc.at("probes")[1].contains("origin"));
 }
 
 TEST(SceneParser, RegionOutsideTheContainerIsRefused) {

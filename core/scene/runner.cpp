@@ -309,7 +309,7 @@ void Runner::write_summary(const RunSummary& r, const FailureReport* failure) {
     std::size_t levels = 1;
     for (std::size_t l = 0; l < w.evaluations.size(); ++l)
       if (w.evaluations[l] > 0) levels = l + 1;
-    j["stepping"] = scene_.time.stepping == TimeStepping::global ? "global" : "per_level";
+    j["stepping"] = to_string(scene_.time.stepping);
     j["force_evaluations_per_level"] =
         std::vector<std::uint64_t>(w.evaluations.begin(), w.evaluations.begin() + static_cast<std::ptrdiff_t>(levels));
     j["pair_interactions"] = w.pairs;

@@ -10,6 +10,7 @@
 #include "core/equation_of_state.hpp"
 #include "core/particle_store.hpp"
 #include "core/scene/scene_builder.hpp"
+#include "core/scene/scene_choices.hpp"
 #include "core/scene/scene_parser.hpp"
 
 namespace sph::scene {
@@ -27,7 +28,7 @@ double gravity_magnitude(const Scene& s) {
 double sound_speed(const Scene& s) {
   const Material& m = s.material;
   if (m.c0) return *m.c0;
-  const double factor = m.mach_factor.value_or(10.0);
+  const double factor = m.mach_factor.value_or(kDefaultMachFactor);
   if (m.reference_speed) return factor * *m.reference_speed;
   if (m.reference_height) return sound_speed_from_height(factor, gravity_magnitude(s), *m.reference_height);
   return 0.0;
@@ -166,27 +167,15 @@ std::string memory_refusal(const MemoryEstimate& need, double available_bytes) {
   return "the scene needs about " + amount(need) + " but " + memory_text(available_bytes) + " are available";
 }
 
-const char* to_string(Shape v) { return v == Shape::rectangle ? "rectangle" : "circle"; }
-const char* to_string(Slip v) { return v == Slip::free_slip ? "free-slip" : "no-slip"; }
-const char* to_string(Criterion v) {
-  switch (v) {
-    case Criterion::velocity: return "velocity";
-    case Criterion::zone: return "zone";
-    case Criterion::few_neighbours: return "few_neighbours";
-  }
-  return "?";
-}
-const char* to_string(Outflow v) { return v == Outflow::stop ? "stop" : "remove"; }
-const char* to_string(Pattern v) { return v == Pattern::aap ? "aap" : "rsp"; }
-const char* to_string(ProbeKind v) {
-  switch (v) {
-    case ProbeKind::water_height: return "water_height";
-    case ProbeKind::surge_front: return "surge_front";
-    case ProbeKind::surface_elevation: return "surface_elevation";
-    case ProbeKind::pressure: return "pressure";
-  }
-  return "?";
-}
+// The names live in one table per enumeration (scene_choices.hpp).
+const char* to_string(Shape v) { return choice_name(v); }
+const char* to_string(Slip v) { return choice_name(v); }
+const char* to_string(Criterion v) { return choice_name(v); }
+const char* to_string(Outflow v) { return choice_name(v); }
+const char* to_string(Pattern v) { return choice_name(v); }
+const char* to_string(ProbeKind v) { return choice_name(v); }
+const char* to_string(GhostPressure v) { return choice_name(v); }
+const char* to_string(TimeStepping v) { return choice_name(v); }
 
 std::vector<std::string> particle_field_names() {
   std::vector<std::string> names;

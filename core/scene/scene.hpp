@@ -45,6 +45,8 @@ struct FluidRegion {
 
 /// rho0 and the sound speed: c0 given directly, or c0 = mach_factor * v_ref with v_ref a speed or the
 /// free-fall speed sqrt(2 g H) from a reference height H.
+inline constexpr double kDefaultMachFactor = 10.0;  // c0 = 10 v_ref: about 1 % density fluctuation
+
 struct Material {
   double rho0 = 1000.0;
   double gamma = 7.0;
@@ -95,7 +97,7 @@ struct Effects {
   std::optional<DensityDiffusion> density_diffusion;
   std::optional<LennardJonesWall> lennard_jones_wall;
   std::optional<Slip> ghost_walls;
-  bool ghost_pressure_mirrored = false;  // ghost_pressure: "hydrostatic" (default) or "mirrored"
+  GhostPressure ghost_pressure = GhostPressure::hydrostatic;
   std::optional<Refinement> refinement;
   std::optional<StaticRefinement> static_refinement;
   bool operator==(const Effects&) const = default;
@@ -202,5 +204,7 @@ const char* to_string(Criterion v);
 const char* to_string(Pattern v);
 const char* to_string(ProbeKind v);
 const char* to_string(Outflow v);
+const char* to_string(GhostPressure v);
+const char* to_string(TimeStepping v);
 
 }  // namespace sph::scene

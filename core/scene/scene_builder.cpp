@@ -21,7 +21,7 @@ SolverSettings solver_settings(const Scene& scene) {
     s.lennard_jones = LennardJonesSettings{lennard_jones_strength(scene), e.lennard_jones_wall->r0_factor, wall_spacing(scene)};
   }
   s.ghosts = e.ghost_walls;
-  s.ghost_pressure = e.ghost_pressure_mirrored ? GhostPressure::mirrored : GhostPressure::hydrostatic;
+  s.ghost_pressure = e.ghost_pressure;
   s.geometry.container = scene.container.box;
   s.geometry.open_top = scene.container.open_top;
   s.geometry.outflow = scene.container.outflow;

@@ -9,6 +9,9 @@
 
 namespace sph::scene::detail {
 
+/// The deepest refinement level a scene may ask for (a region's level, refinement.max_level).
+inline constexpr int kMaxLevel = 8;
+
 [[noreturn]] inline void fail(const std::string& path, const std::string& rule) { throw SceneError(path, rule); }
 
 inline std::string join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }

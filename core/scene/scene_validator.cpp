@@ -1,5 +1,7 @@
-// The value rules of a scene (validate_scene): ranges, geometry, consistency between sections. A broken rule
-// throws SceneError naming the key path; the parser (scene_parser.cpp) checks structure and types first.
+// The value rules of a scene (validate_scene). Each key's own range is declared with the key (scene_keys.cpp) and
+// checked first, through the registry; what follows here are the rules across keys: geometry, consistency
+// between sections, resolution and size. A broken rule throws SceneError naming the key path; the parser
+// (scene_parser.cpp) checks structure and types first.
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -7,6 +9,7 @@
 
 #include "core/scene/scene_parser.hpp"
 #include "core/scene/scene_rules.hpp"
+#include "core/scene/scene_schema.hpp"
 
 namespace sph::scene {
 
@@ -17,10 +20,6 @@ using detail::list;
 using detail::num;
 
 namespace {
-
-void positive(double x, const std::string& path, const std::string& what = "must be positive") {
-  if (!(x > 0.0)) fail(path, what + " (got " + num(x) + ")");
-}
 
 void valid_rect(const Rect& r, const std::string& path) {
   if (!(r.hi[0] > r.lo[0] && r.hi[1] > r.lo[1])) {
@@ -40,7 +39,6 @@ double distance_to_rect(const Vec<2>& p, const Rect& r) {
 }
 
 constexpr double kTol = 1e-9;
-constexpr int kMaxLevel = 8;
 constexpr double kMaxParticles = 5.0e7;
 
 bool inside(const Rect& inner, const Rect& outer) {
@@ -78,15 +76,7 @@ bool regions_overlap(const FluidRegion& a, const FluidRegion& b, double t) {
 }
 
 void validate_region(const Scene& s, const FluidRegion& f, const std::string& path) {
-  if (f.shape == Shape::rectangle) {
-    valid_rect(f.rect, path);
-  } else {
-    positive(f.radius, join(path, "radius"));
-  }
-  positive(f.spacing, join(path, "spacing"));
-  if (f.level < 0 || f.level > kMaxLevel) {
-    fail(join(path, "level"), "must be between 0 and " + std::to_string(kMaxLevel) + " (got " + std::to_string(f.level) + ")");
-  }
+  if (f.shape == Shape::rectangle) valid_rect(f.rect, path);
   const double d = f.lattice_spacing();
   if (!inside(bounds(f), s.container.box)) {
     fail(path, std::string("the ") + to_string(f.shape) + " reaches outside the container");
@@ -119,7 +109,6 @@ void validate_probe(const Scene& s, const Probe& p, const std::string& path) {
   const Rect& c = s.container.box;
   if (p.kind == ProbeKind::water_height || p.kind == ProbeKind::surface_elevation) {
     if (p.x < c.lo[0] - kTol || p.x > c.hi[0] + kTol) fail(join(path, "x"), "must lie within the container's x range");
-    if (p.band) positive(*p.band, join(path, "band"));
   }
   if (p.kind == ProbeKind::pressure && !inside(Rect{p.position, p.position}, c)) {
     fail(join(path, "position"), "must lie inside the container");
@@ -135,6 +124,7 @@ void validate_probe(const Scene& s, const Probe& p, const std::string& path) {
 }  // namespace
 
 void validate_scene(const Scene& s) {
+  schema::check_section(schema::scene_section(), s, "");
   if (s.name.empty()) fail("name", "must not be empty");
   for (char ch : s.name) {
     if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-' || ch == '.')) {
@@ -154,56 +144,28 @@ void validate_scene(const Scene& s) {
 
   // Material and effects come first: the regions' rules (hydrostatic) depend on gravity.
   const Material& m = s.material;
-  positive(m.rho0, "material.rho0");
-  if (!(m.gamma >= 1.0)) fail("material.gamma", "must be at least 1 (got " + num(m.gamma) + ")");
   if (m.c0) {
-    positive(*m.c0, "material.c0");
     if (m.mach_factor || m.reference_speed || m.reference_height) {
       fail("material", "give either c0, or mach_factor with reference_speed or reference_height, not both");
     }
   } else {
-    if (m.mach_factor) positive(*m.mach_factor, "material.mach_factor");
     if (m.reference_speed && m.reference_height) {
       fail("material", "give reference_speed or reference_height, not both");
     }
-    if (m.reference_speed) {
-      positive(*m.reference_speed, "material.reference_speed");
-    } else if (m.reference_height) {
-      positive(*m.reference_height, "material.reference_height");
-      if (gravity_magnitude(s) <= 0.0) fail("material.reference_height", "needs effects.gravity (v_ref = sqrt(2 g H))");
-    } else {
+    if (m.reference_height && gravity_magnitude(s) <= 0.0) {
+      fail("material.reference_height", "needs effects.gravity (v_ref = sqrt(2 g H))");
+    }
+    if (!m.reference_speed && !m.reference_height) {
       fail("material.c0", "missing required key (or give mach_factor with reference_speed or reference_height)");
     }
   }
-  if (!(s.h_factor >= 0.5 && s.h_factor <= 3.0)) fail("h_factor", "must be between 0.5 and 3 (got " + num(s.h_factor) + ")");
 
   const Effects& e = s.effects;
   if (e.gravity && !(e.gravity->norm() > 0.0)) fail("effects.gravity", "must not be zero (remove the key to turn gravity off)");
-  if (e.artificial_viscosity) {
-    if (!(e.artificial_viscosity->alpha >= 0.0)) fail("effects.artificial_viscosity.alpha", "must not be negative");
-    if (!(e.artificial_viscosity->beta >= 0.0)) fail("effects.artificial_viscosity.beta", "must not be negative");
-  }
-  if (e.artificial_stress) {
-    const double eps = e.artificial_stress->epsilon;
-    if (!(eps > 0.0 && eps <= 1.0)) fail("effects.artificial_stress.epsilon", "must be in (0, 1] (got " + num(eps) + ")");
-    const int n = e.artificial_stress->exponent;
-    if (n < 1 || n > 16) fail("effects.artificial_stress.exponent", "must be between 1 and 16 (got " + std::to_string(n) + ")");
-  }
-  if (e.density_diffusion) {
-    const double delta = e.density_diffusion->delta;
-    if (!(delta > 0.0 && delta <= 1.0)) fail("effects.density_diffusion.delta", "must be in (0, 1] (got " + num(delta) + ")");
-  }
   if (e.refinement) {
     const Refinement& r = *e.refinement;
     const std::string p = "effects.refinement";
-    if (r.criterion == Criterion::velocity) positive(r.v_threshold, p + ".v_threshold");
     if (r.criterion == Criterion::zone) valid_rect(r.zone, p + ".zone");
-    if (r.criterion == Criterion::few_neighbours && r.min_neighbours < 1) fail(p + ".min_neighbours", "must be at least 1");
-    if (!(r.rsp_k > 0.0 && r.rsp_k <= 2.0)) fail(p + ".rsp_k", "must be in (0, 2] (got " + num(r.rsp_k) + ")");
-    if (r.check_interval < 1) fail(p + ".check_interval", "must be at least 1 step");
-    if (r.max_level < 1 || r.max_level > kMaxLevel) {
-      fail(p + ".max_level", "must be between 1 and " + std::to_string(kMaxLevel) + " (got " + std::to_string(r.max_level) + ")");
-    }
     if (const auto& c = r.coarsening) {
       const std::string q = p + ".coarsening";
       if (r.criterion == Criterion::velocity && !(c->v_threshold > 0.0 && c->v_threshold < r.v_threshold)) {
@@ -215,13 +177,10 @@ void validate_scene(const Scene& s) {
                                         ", or a family could split and merge at alternate checks (got " +
                                         std::to_string(c->min_neighbours) + ")");
       }
-      if (!(c->hold_time >= 0.0 && std::isfinite(c->hold_time))) fail(q + ".hold_time", "must be 0 s or more (got " + num(c->hold_time) + ")");
     }
   }
   if (e.static_refinement) {
     if (e.static_refinement->box) valid_rect(*e.static_refinement->box, "effects.static_refinement.box");
-    const double k = e.static_refinement->rsp_k;
-    if (!(k > 0.0 && k <= 2.0)) fail("effects.static_refinement.rsp_k", "must be in (0, 2] (got " + num(k) + ")");
   }
 
   if (s.fluid.empty()) fail("fluid", "at least one fluid region is required");
@@ -257,16 +216,10 @@ void validate_scene(const Scene& s) {
     const LennardJonesWall& w = *e.lennard_jones_wall;
     const std::string p = "effects.lennard_jones_wall";
     if (w.strength && w.reference_height) fail(p, "give strength or reference_height, not both");
-    if (w.strength) {
-      positive(*w.strength, p + ".strength");
-    } else if (w.reference_height) {
-      positive(*w.reference_height, p + ".reference_height");
-      if (gravity_magnitude(s) <= 0.0) fail(p + ".reference_height", "needs effects.gravity (D = 5 g H)");
-    } else {
-      fail(p + ".strength", "missing required key (or give reference_height, D = 5 g H)");
+    if (!w.strength && w.reference_height && gravity_magnitude(s) <= 0.0) {
+      fail(p + ".reference_height", "needs effects.gravity (D = 5 g H)");
     }
-    if (!(w.r0_factor > 0.0 && w.r0_factor <= 2.0)) fail(p + ".r0_factor", "must be in (0, 2] (got " + num(w.r0_factor) + ")");
-    if (w.spacing) positive(*w.spacing, p + ".spacing");
+    if (!w.strength && !w.reference_height) fail(p + ".strength", "missing required key (or give reference_height, D = 5 g H)");
     // Resolution rule: at the finest level the scene can reach (spacing d), the repulsion range r0 =
     // r0_factor d must cover the wall-particle spacing, or particles of that level slip between them.
     const double d = finest_spacing(s);
@@ -284,12 +237,8 @@ void validate_scene(const Scene& s) {
   }
 
   const Time& t = s.time;
-  positive(t.end, "time.end");
-  if (!(t.cfl > 0.0 && t.cfl <= 1.0)) fail("time.cfl", "must be in (0, 1] (got " + num(t.cfl) + ")");
-  positive(t.dt_max, "time.dt_max");
   if (t.end / t.dt_max > 1e9) fail("time.dt_max", "would take more than 1e9 steps to reach time.end");
   if (t.output_interval) {
-    positive(*t.output_interval, "time.output_interval");
     if (t.end / *t.output_interval > 1e6) fail("time.output_interval", "would write more than a million outputs");
   }
 
@@ -302,7 +251,6 @@ void validate_scene(const Scene& s) {
 
   const Output& o = s.output;
   if (o.frame_interval) {
-    positive(*o.frame_interval, "output.frame_interval");
     if (t.end / *o.frame_interval > 1e6) fail("output.frame_interval", "would write more than a million frames");
   }
   const auto names = particle_field_names();
