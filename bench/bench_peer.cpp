@@ -24,35 +24,30 @@ struct PeerCase {
 };
 constexpr PeerCase kCases[] = {{1.0 / 45, 0.4}, {1.0 / 122, 0.1}, {1.0 / 354, 0.008}};
 
-void BM_Peer_DamBreak(benchmark::State& state) {
-  const PeerCase c = kCases[state.range(0)];
-  omp_set_num_threads(static_cast<int>(state.range(1)));
-  const double h_factor = static_cast<double>(state.range(2)) / 1000.0;
+/// Times whole runs from rest over `window` simulated seconds, the simulation built by make() outside the timing,
+/// and reports fluid particle-steps/s, pair interactions/s and pairs per particle-step.
+template <class Make>
+void time_window(benchmark::State& state, Make make, double window) {
   std::uint64_t steps = 0;
-  std::size_t fluid = 0;
+  std::size_t fluid = 0, walls = 0;
   double pairs = 0;
   for (auto _ : state) {
     state.PauseTiming();
-    DamBreakSpec spec;
-    spec.column_width = 1.0;
-    spec.column_height = 2.0;
-    spec.tank_width = 4.0;
-    spec.tank_height = 3.0;
-    spec.spacing = c.dp;
-    spec.h_factor = h_factor;
-    spec.mach_factor = 20.0 / std::sqrt(2.0);  // c0 = mach sqrt(2 g H) = 20 sqrt(g H)
-    Simulation sim = make_dam_break(spec);
+    auto sim = make();
     sim.set_clock(0.0, 0, sim.dt());
-    fluid = sim.diagnostics().fluid;
+    const auto d = sim.diagnostics();
+    fluid = d.fluid;
+    walls = d.walls;
     pairs = 0;
     state.ResumeTiming();
-    while (sim.time() < c.window) {
-      const StepInfo info = sim.step(c.window - sim.time());
+    while (sim.time() < window) {
+      const StepInfo info = sim.step(window - sim.time());
       pairs += static_cast<double>(info.limits.pairs);
     }
     steps = sim.step_count();
   }
   state.counters["fluid"] = static_cast<double>(fluid);
+  state.counters["walls"] = static_cast<double>(walls);
   state.counters["steps"] = static_cast<double>(steps);
   state.counters["particle_steps_per_s"] =
       benchmark::Counter(static_cast<double>(fluid * steps) * static_cast<double>(state.iterations()),
@@ -60,6 +55,20 @@ void BM_Peer_DamBreak(benchmark::State& state) {
   state.counters["pairs_per_s"] =
       benchmark::Counter(pairs * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["pairs_per_particle"] = pairs / static_cast<double>(fluid * steps);
+}
+
+void BM_Peer_DamBreak(benchmark::State& state) {
+  const PeerCase c = kCases[state.range(0)];
+  omp_set_num_threads(static_cast<int>(state.range(1)));
+  DamBreakSpec spec;
+  spec.column_width = 1.0;
+  spec.column_height = 2.0;
+  spec.tank_width = 4.0;
+  spec.tank_height = 3.0;
+  spec.spacing = c.dp;
+  spec.h_factor = static_cast<double>(state.range(2)) / 1000.0;
+  spec.mach_factor = 20.0 / std::sqrt(2.0);  // c0 = mach sqrt(2 g H) = 20 sqrt(g H)
+  time_window(state, [&] { return make_dam_break(spec); }, c.window);
 }
 
 void peer_args(benchmark::internal::Benchmark* b) {
@@ -88,32 +97,7 @@ void BM_Peer_DamBreak3D(benchmark::State& state) {
   DamBreak3Spec spec;
   spec.spacing = c.dp;
   spec.h_factor = static_cast<double>(state.range(2)) / 1000.0;
-  std::uint64_t steps = 0;
-  std::size_t fluid = 0, walls = 0;
-  double pairs = 0;
-  for (auto _ : state) {
-    state.PauseTiming();
-    SimulationT<3> sim = make_dam_break(spec);
-    const auto d = sim.diagnostics();
-    fluid = d.fluid;
-    walls = d.walls;
-    pairs = 0;
-    state.ResumeTiming();
-    while (sim.time() < c.window) {
-      const StepInfo info = sim.step(c.window - sim.time());
-      pairs += static_cast<double>(info.limits.pairs);
-    }
-    steps = sim.step_count();
-  }
-  state.counters["fluid"] = static_cast<double>(fluid);
-  state.counters["walls"] = static_cast<double>(walls);
-  state.counters["steps"] = static_cast<double>(steps);
-  state.counters["particle_steps_per_s"] =
-      benchmark::Counter(static_cast<double>(fluid * steps) * static_cast<double>(state.iterations()),
-                         benchmark::Counter::kIsRate);
-  state.counters["pairs_per_s"] =
-      benchmark::Counter(pairs * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
-  state.counters["pairs_per_particle"] = pairs / static_cast<double>(fluid * steps);
+  time_window(state, [&] { return make_dam_break(spec); }, c.window);
 }
 
 void peer3_args(benchmark::internal::Benchmark* b) {

@@ -9,6 +9,7 @@
 #include <limits>
 #include <vector>
 
+#include "tests/support/thread_count.hpp"
 #include "core/boundary/ghosts.hpp"
 #include "core/boundary/wall.hpp"
 #include "core/boundary/wall_particles.hpp"
@@ -34,16 +35,7 @@ using Vec3 = Vec<3>;
 
 constexpr double kG = 9.81;
 
-class ThreadCount {
- public:
-  explicit ThreadCount(int n) : saved_(omp_get_max_threads()) { omp_set_num_threads(n); }
-  ~ThreadCount() { omp_set_num_threads(saved_); }
-  ThreadCount(const ThreadCount&) = delete;
-  ThreadCount& operator=(const ThreadCount&) = delete;
-
- private:
-  int saved_;
-};
+using sph::test::ThreadCount;
 
 sph::Geometry3 unit_box(bool open_top) {
   sph::Geometry3 g;
@@ -556,12 +548,18 @@ TEST(DamBreak3D, PeerCaseRunsWithItsColumn) {
 // ---------------------------------------------------------------------------------------------------
 // Output in 3D
 
-TEST(Io3D, FramesAreNByThreeAndXdmfSaysXYZ) {
-  sph::test::TempFolder tmp;
+/// A 0.3 x 0.2 m tank, 0.2 m deep (96 particles).
+sph::Tank3Spec small_tank() {
   sph::Tank3Spec spec;
   spec.length = 0.3;
   spec.width = 0.2;
   spec.depth = 0.2;
+  return spec;
+}
+
+TEST(Io3D, FramesAreNByThreeAndXdmfSaysXYZ) {
+  sph::test::TempFolder tmp;
+  const sph::Tank3Spec spec = small_tank();
   sph::SimulationT<3> sim = sph::make_still_tank(spec);
   for (int k = 0; k < 3; ++k) sim.step();
   const auto& s = sim.store();
@@ -589,10 +587,7 @@ TEST(Io3D, FramesAreNByThreeAndXdmfSaysXYZ) {
 
 TEST(Io3D, CheckpointResumesBitwiseAndRefusesTheOtherDimension) {
   sph::test::TempFolder tmp;
-  sph::Tank3Spec spec;
-  spec.length = 0.3;
-  spec.width = 0.2;
-  spec.depth = 0.2;
+  const sph::Tank3Spec spec = small_tank();
   sph::SimulationT<3> a = sph::make_still_tank(spec);
   for (int k = 0; k < 5; ++k) a.step();
   a.remove_ghosts();

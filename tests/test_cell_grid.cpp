@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "tests/support/thread_count.hpp"
 #include "core/cell_grid.hpp"
 #include "core/types.hpp"
 #include "tests/support/brute_force.hpp"
@@ -31,17 +32,7 @@ std::size_t scaled(std::size_t n) {
   return test::short_runs() ? std::max<std::size_t>(n / 4, 1) : n;
 }
 
-/// Restores the OpenMP thread count on scope exit.
-class ThreadCount {
- public:
-  explicit ThreadCount(int n) : saved_(omp_get_max_threads()) { omp_set_num_threads(n); }
-  ~ThreadCount() { omp_set_num_threads(saved_); }
-  ThreadCount(const ThreadCount&) = delete;
-  ThreadCount& operator=(const ThreadCount&) = delete;
-
- private:
-  int saved_;
-};
+using sph::test::ThreadCount;
 
 template <int D>
 struct Points {

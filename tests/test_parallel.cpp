@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "tests/support/thread_count.hpp"
 #include "core/types.hpp"
 #include "parallel/compaction.hpp"
 #include "parallel/counting_sort.hpp"
@@ -22,17 +23,7 @@
 namespace sph {
 namespace {
 
-/// Restores the OpenMP thread count on scope exit.
-class ThreadCount {
- public:
-  explicit ThreadCount(int n) : saved_(omp_get_max_threads()) { omp_set_num_threads(n); }
-  ~ThreadCount() { omp_set_num_threads(saved_); }
-  ThreadCount(const ThreadCount&) = delete;
-  ThreadCount& operator=(const ThreadCount&) = delete;
-
- private:
-  int saved_;
-};
+using sph::test::ThreadCount;
 
 constexpr int kThreadCounts[] = {1, 2, 4};
 

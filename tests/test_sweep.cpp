@@ -305,16 +305,7 @@ SolverSettings twin_settings(bool viscosity, bool lennard_jones) {
 ParticleStore<2> twin_cloud(const SolverSettings& st, std::uint32_t seed) {
   ParticleStore<2> s = random_cloud(700, 10.0, 0.5, st.eos, seed, 1.5);
   for (std::size_t i = 0; i < s.size(); i += 7) s.kind[i] = Kind::ghost;
-  for (int k = 0; k <= 40; ++k) {
-    ParticleInit w;
-    w.x = Vec<2>(0.25 * k, 0.0);
-    w.m = 0.0;
-    w.h = 0.0;
-    w.d = 0.125;
-    w.rho = st.eos.rho0;
-    w.kind = Kind::wall;
-    add_particle(s, w, st.eos);
-  }
+  for (int k = 0; k <= 40; ++k) add_particle(s, wall_particle<2>(Vec<2>(0.25 * k, 0.0), 0.125, st.eos.rho0), st.eos);
   return s;
 }
 
@@ -465,18 +456,9 @@ ParticleStore<3> twin_cloud_3d(const sph::SolverSettingsT<3>& st, std::uint32_t 
   for (std::size_t i = 0; i < s.size(); i += 7) s.kind[i] = Kind::ghost;
   for (std::size_t i = 0; i < s.size(); ++i)  // some fluid within reach of the wall plane's repulsion
     if (s.kind[i] == Kind::fluid && i % 5 == 1) s.x[i][2] = 0.02 + 0.2 * s.d[i] * (static_cast<double>(i % 11) / 11.0);
-  for (int kx = 0; kx <= 20; ++kx) {
-    for (int ky = 0; ky <= 20; ++ky) {
-      ParticleInitT<3> w;
-      w.x = Vec<3>(0.25 * kx, 0.25 * ky, 0.0);
-      w.m = 0.0;
-      w.h = 0.0;
-      w.d = 0.125;
-      w.rho = st.eos.rho0;
-      w.kind = Kind::wall;
-      add_particle(s, w, st.eos);
-    }
-  }
+  for (int kx = 0; kx <= 20; ++kx)
+    for (int ky = 0; ky <= 20; ++ky)
+      add_particle(s, wall_particle<3>(Vec<3>(0.25 * kx, 0.25 * ky, 0.0), 0.125, st.eos.rho0), st.eos);
   return s;
 }
 

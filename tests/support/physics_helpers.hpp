@@ -50,6 +50,19 @@ std::size_t add_particle(ParticleStore<D>& s, const ParticleInitT<D>& p, const T
   return i;
 }
 
+/// A fixed wall particle at x (no mass, no smoothing length: reached through the fluid particle's support).
+template <int D>
+ParticleInitT<D> wall_particle(const Vec<D>& x, double spacing, double rho0) {
+  ParticleInitT<D> w;
+  w.x = x;
+  w.m = 0.0;
+  w.h = 0.0;
+  w.d = spacing;
+  w.rho = rho0;
+  w.kind = Kind::wall;
+  return w;
+}
+
 /// A random cloud of `n` fluid particles in [0, side]^D on two refinement levels (level 1: half the
 /// spacing, 2^-D of the mass, half the smoothing length), with random velocities and densities
 /// within 1 % of rho0. Positions are jittered lattice-free uniform draws, so pair geometries are generic.
