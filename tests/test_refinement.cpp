@@ -308,7 +308,7 @@ std::string scientific(double x) {
   return buf;
 }
 
-double scaled_end() { return test::short_runs() ? 0.8 : 2.0; }
+double scaled_end() { return test::short_runs() ? 0.5 : 2.0; }
 
 class DynamicDamBreak : public ::testing::TestWithParam<Pattern> {};
 

@@ -114,9 +114,9 @@ void run_still_tank(double spacing, bool density_diffusion = false) {
   ASSERT_EQ(start.outside, 0u) << start.describe();
 
   // 10 s (~25 sloshing periods of the tank's first mode). Under the sanitizer preset (SPH_TEST_SCALE=short)
-  // 2 s: that run looks for memory and undefined-behaviour errors, which the first steps already exercise;
+  // 1 s: that run looks for memory and undefined-behaviour errors, which the first steps already exercise;
   // the physics is held to the full 10 s by the release run.
-  const double t_end = sph::test::short_runs() ? 2.0 : 10.0;
+  const double t_end = sph::test::short_runs() ? 1.0 : 10.0;
   double max_speed_seen = 0.0;
   // The band pressures oscillate (the tank's compression mode: the bottom band swings by a few per cent at
   // ~2.6 Hz, undamped), so they are judged by their time average over the second half of the run (the last

@@ -1,3 +1,6 @@
+#pragma once
+// The driver's definitions, instantiated once per dimension (simulation_2d.cpp, simulation_3d.cpp: two
+// translation units, which a parallel build compiles side by side).
 #include "core/simulation.hpp"
 
 #include <algorithm>
@@ -291,8 +294,5 @@ DiagnosticsT<D> SimulationT<D>::diagnostics() const {
   d.removed_mass = removed_.mass.value();
   return d;
 }
-
-template class SimulationT<2>;
-template class SimulationT<3>;
 
 }  // namespace sph
