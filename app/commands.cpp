@@ -45,7 +45,20 @@ std::string levels_text(const std::vector<std::size_t>& per_level) {
   return out.empty() ? "none" : out;
 }
 
-void print_summary(const scene::Scene& s, const scene::RunSummary& r, const std::filesystem::path& folder) {
+/// "[1.5e+00, -2.0e-03]" or "[..., ..., ...]".
+template <int D>
+std::string vector_text(const Vec<D>& v) {
+  std::string out = "[";
+  char buf[32];
+  for (int a = 0; a < D; ++a) {
+    std::snprintf(buf, sizeof buf, "%.3e", v[a]);
+    out += (a ? ", " : "") + std::string(buf);
+  }
+  return out + "]";
+}
+
+template <int D>
+void print_summary(const scene::Scene& s, const scene::RunSummaryT<D>& r, const std::filesystem::path& folder) {
   const double pps = r.wall_seconds > 0.0 ? static_cast<double>(r.particle_steps) / r.wall_seconds : 0.0;
   std::printf("sphrefine: %s reached t = %.6g s (step %llu) in %.3f s wall\n", s.name.c_str(), r.final.time,
               static_cast<unsigned long long>(r.final.step), r.wall_seconds);
@@ -58,8 +71,8 @@ void print_summary(const scene::Scene& s, const scene::RunSummary& r, const std:
                 r.initial_mass > 0.0 ? 100.0 * r.final.removed_mass / r.initial_mass : 0.0);
   }
   std::printf("  mass drift         %+.3e (relative, removed fluid counted)\n", r.mass_drift);
-  std::printf("  momentum change    |P - P0| = %.3e kg m/s (P = [%.3e, %.3e])\n", r.momentum_change,
-              r.final.momentum[0], r.final.momentum[1]);
+  std::printf("  momentum change    |P - P0| = %.3e kg m/s (P = %s)\n", r.momentum_change,
+              vector_text<D>(r.final.momentum).c_str());
   if (!folder.empty()) {
     std::printf("  output             %s (%llu rows, %llu frames, %llu checkpoints)\n", folder.string().c_str(),
                 static_cast<unsigned long long>(r.rows), static_cast<unsigned long long>(r.frames),
@@ -189,6 +202,47 @@ std::string checkpoint_every_option_error(const std::string& value) {
   return "";
 }
 
+namespace {
+
+template <int D>
+void run_scene(const scene::Scene& s, const scene::RunOptions& options, const RunArguments& args,
+               const io::RunFiles& files, const std::filesystem::path& folder, ProgressPrinter& progress) {
+  {
+    scene::RunnerT<D> runner(s, options);
+    if (args.force && args.resume.empty()) files.clear_run();
+    if (!args.quiet) {
+      std::printf("sphrefine %s: %s (%dD), %zu fluid particles, threads %d, sweep %s -> %s\n", SPH_VERSION,
+                  s.name.c_str(), D, runner.simulation().diagnostics().fluid, omp_get_max_threads(),
+                  runner.simulation().sweep_name(), folder.string().c_str());
+      if (options.resume) {
+        std::printf("resuming from %s at t = %.6g s (step %llu)\n", args.resume.c_str(), runner.simulation().time(),
+                    static_cast<unsigned long long>(runner.simulation().step_count()));
+      }
+      std::fflush(stdout);
+    }
+    const scene::RunSummaryT<D> summary = runner.run([&](const scene::Progress& p) { progress(p); });
+    progress.done();
+    print_summary<D>(s, summary, folder);
+  }
+}
+
+template <int D>
+void describe_scene(const scene::Scene& s, const std::string& memory) {
+  {
+    const SimulationT<D> sim = scene::build_simulation<D>(s);
+    const DiagnosticsT<D> d = sim.diagnostics();
+    std::printf("scene OK: %s (%dD)\n", s.name.c_str(), D);
+    std::printf("  fluid particles    %zu (%s), wall particles %zu\n", d.fluid, levels_text(d.per_level).c_str(), d.walls);
+    std::printf("  sound speed        c0 = %.6g m/s, finest level %d (spacing %.6g m)\n", scene::sound_speed(s),
+                scene::finest_level(s), scene::finest_spacing(s));
+    std::printf("  sweep              %s%s\n", sim.sweep_name(), s.effects.ghost_walls ? ", ghost walls" : "");
+    std::printf("  first time step    %.6g s, end time %.6g s\n", sim.dt(), s.time.end);
+    std::printf("  memory             %s\n", memory.c_str());
+  }
+}
+
+}  // namespace
+
 int run_command(const RunArguments& args) {
   scene::Scene s;
   try {
@@ -228,21 +282,10 @@ int run_command(const RunArguments& args) {
   options.threads_from_work = args.threads <= 0;  // --threads fixes the count; otherwise it follows the work
   ProgressPrinter progress(stdout, args.quiet);
   try {
-    scene::Runner runner(s, options);
-    if (args.force && args.resume.empty()) files.clear_run();
-    if (!args.quiet) {
-      std::printf("sphrefine %s: %s, %zu fluid particles, threads %d, sweep %s -> %s\n", SPH_VERSION, s.name.c_str(),
-                  runner.simulation().diagnostics().fluid, omp_get_max_threads(), runner.simulation().sweep_name(),
-                  folder.string().c_str());
-      if (options.resume) {
-        std::printf("resuming from %s at t = %.6g s (step %llu)\n", args.resume.c_str(), runner.simulation().time(),
-                    static_cast<unsigned long long>(runner.simulation().step_count()));
-      }
-      std::fflush(stdout);
-    }
-    const scene::RunSummary summary = runner.run([&](const scene::Progress& p) { progress(p); });
-    progress.done();
-    print_summary(s, summary, folder);
+    scene::with_dimension(s, [&](auto dim) {
+      constexpr int D = decltype(dim)::value;
+      run_scene<D>(s, options, args, files, folder, progress);
+    });
   } catch (const scene::SceneError& e) {
     progress.done();
     return scene_error(e);
@@ -264,15 +307,10 @@ int validate_command(const std::string& path, const std::vector<std::string>& ov
   std::string memory;
   if (!memory_fits(s, &memory)) return kExitUsage;
   try {
-    const Simulation sim = scene::build_simulation(s);
-    const Diagnostics d = sim.diagnostics();
-    std::printf("scene OK: %s\n", s.name.c_str());
-    std::printf("  fluid particles    %zu (%s), wall particles %zu\n", d.fluid, levels_text(d.per_level).c_str(), d.walls);
-    std::printf("  sound speed        c0 = %.6g m/s, finest level %d (spacing %.6g m)\n", scene::sound_speed(s),
-                scene::finest_level(s), scene::finest_spacing(s));
-    std::printf("  sweep              %s%s\n", sim.sweep_name(), s.effects.ghost_walls ? ", ghost walls" : "");
-    std::printf("  first time step    %.6g s, end time %.6g s\n", sim.dt(), s.time.end);
-    std::printf("  memory             %s\n", memory.c_str());
+    scene::with_dimension(s, [&](auto dim) {
+      constexpr int D = decltype(dim)::value;
+      describe_scene<D>(s, memory);
+    });
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: the scene passed validation but could not be set up: %s\n", e.what());
     return kExitFailure;

@@ -65,6 +65,37 @@ inline std::vector<Vec<2>> lattice_circle(const Vec<2>& centre, double radius, d
   return pts;
 }
 
+/// Lattice points of spacing d through the centre, inside the 3D ball (x fastest).
+inline std::vector<Vec<3>> lattice_ball(const Vec<3>& centre, double radius, double d) {
+  std::vector<Vec<3>> pts;
+  const auto n = static_cast<long>(std::ceil(radius / d)) + 1;
+  for (long iz = -n; iz <= n; ++iz)
+    for (long iy = -n; iy <= n; ++iy)
+      for (long ix = -n; ix <= n; ++ix) {
+        const Vec<3> p = centre + d * Vec<3>(static_cast<double>(ix), static_cast<double>(iy), static_cast<double>(iz));
+        if ((p - centre).norm() <= radius) pts.push_back(p);
+      }
+  return pts;
+}
+
+/// The lattice of a box (a rectangle in 2D) or of a ball (a disc in 2D), in D dimensions.
+template <int D>
+std::vector<Vec<D>> lattice_block(const Vec<D>& lo, const Vec<D>& hi, double d) {
+  if constexpr (D == 2) {
+    return lattice_rectangle(lo, hi, d);
+  } else {
+    return lattice_box(lo, hi, d);
+  }
+}
+template <int D>
+std::vector<Vec<D>> lattice_round(const Vec<D>& centre, double radius, double d) {
+  if constexpr (D == 2) {
+    return lattice_circle(centre, radius, d);
+  } else {
+    return lattice_ball(centre, radius, d);
+  }
+}
+
 /// Appends fluid particles at the given points, at rest density rho0, mass rho0 d^D.
 template <int D>
 std::size_t add_fluid(ParticleStore<D>& store, const std::vector<Vec<D>>& points, const FluidBlockSpecT<D>& spec,

@@ -2,12 +2,43 @@
 // Basic types shared by the whole library.
 #include <Eigen/Core>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 
 namespace sph {
 
 /// A point or vector in D dimensions (D = 2 or 3).
 template <int D>
 using Vec = Eigen::Matrix<double, D, 1>;
+
+/// A point or vector whose dimension is known only when a scene is read: 2 or 3 coordinates, or none (a vector
+/// left at its default, zero). What a scene holds before the solver is chosen for the scene's dimension;
+/// `fixed<D>()` gives the solver's Vec<D>. Compared by size and value.
+struct AnyVec : Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 3, 1> {
+  using Base = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 3, 1>;
+  AnyVec() = default;
+  explicit AnyVec(Eigen::Index n) : Base(n) {}  // n coordinates, unset
+  template <class Other>
+  AnyVec(const Eigen::MatrixBase<Other>& other) : Base(other) {}  // NOLINT: a Vec<D> is an AnyVec
+  template <class Other>
+  AnyVec& operator=(const Eigen::MatrixBase<Other>& other) {
+    Base::operator=(other);
+    return *this;
+  }
+  bool operator==(const AnyVec& o) const {
+    return size() == o.size() && (size() == 0 || static_cast<const Base&>(*this) == static_cast<const Base&>(o));
+  }
+  /// The vector in D dimensions; empty is zero. Throws std::invalid_argument for another dimension.
+  template <int D>
+  Vec<D> fixed() const {
+    if (size() == 0) return Vec<D>::Zero();
+    if (size() != D) {
+      throw std::invalid_argument("a vector of " + std::to_string(size()) + " coordinates where " + std::to_string(D) +
+                                  " are needed");
+    }
+    return Vec<D>(data());
+  }
+};
 
 /// What a particle is: a real fluid particle, a fixed wall particle (Lennard-Jones repulsion, eq. 10),
 /// or a ghost mirrored from a fluid particle across a wall (section 2.4).

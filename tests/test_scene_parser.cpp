@@ -184,8 +184,13 @@ TEST(SceneParser, WrongTypeIsRefused) {
   doc["container"]["open_top"] = 1;
   EXPECT_EQ(error_of(doc), "scene error: container.open_top: must be true or false (got an integer)");
   doc = full_scene();
+  doc["fluid"][1]["centre"] = Json::array({1, 2, 3, 4});
+  EXPECT_EQ(error_of(doc), "scene error: fluid[1].centre: must be an array of two numbers [x, y] (2D) or three [x, y, z] "
+                           "(3D) (got an array of 4)");
+  doc = full_scene();
   doc["fluid"][1]["centre"] = Json::array({1, 2, 3});
-  EXPECT_EQ(error_of(doc), "scene error: fluid[1].centre: must be an array of two numbers [x, y] (got an array of 3)");
+  EXPECT_EQ(error_of(doc), "scene error: fluid[1].centre: has 3 numbers, but the scene is 2D (container.lo has 2): write "
+                           "two numbers [x, y]");
   doc = full_scene();
   doc["effects"]["refinement"]["max_level"] = 1.5;
   EXPECT_EQ(error_of(doc), "scene error: effects.refinement.max_level: must be an integer (got a number)");
@@ -508,7 +513,7 @@ TEST(SceneParser, OverridesEditTheDocumentBeforeValidation) {
   const Scene s = scene_from_json(doc);
   EXPECT_DOUBLE_EQ(s.time.end, 3.0);
   EXPECT_EQ(s.effects.ghost_walls, Slip::free_slip);
-  EXPECT_EQ(s.fluid[1].velocity, sph::Vec<2>(1, 2));
+  EXPECT_EQ(s.fluid[1].velocity, sph::AnyVec(sph::Vec<2>(1, 2)));
   EXPECT_DOUBLE_EQ(s.fluid[0].spacing, 0.25);
   EXPECT_FALSE(s.effects.refinement);
   EXPECT_FALSE(s.output.frames);

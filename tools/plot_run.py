@@ -2,6 +2,9 @@
 """Plots one run's output folder: the probes and diagnostics over time (series.png) and the particles
 coloured by speed at four times (particles.png).   /usr/bin/python3 tools/plot_run.py RESULTS_FOLDER
 
+A 3D run is shown from the side: x across, z up, seen from the container's low-y face, the particles nearest to
+that face drawn on top; its wall particles are left out (they would hide the fluid).
+
 particles.png shows the whole container (walls drawn, the top dashed when open, obstacles filled) at the
 same scale in every panel; the panels are laid out in a row, a 2 x 2 grid or a column, whichever gives them
 the most room for the container's aspect, and each particle is drawn as wide as its spacing."""
@@ -19,7 +22,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
 
 BASE = ["time", "step", "dt", "fluid", "ghosts", "walls", "mass", "removed", "removed_mass", "momentum_x", "momentum_y",
-        "angular_momentum", "kinetic", "potential", "elastic", "total_energy", "max_speed", "max_density_error"]
+        "momentum_z", "angular_momentum", "angular_momentum_x", "angular_momentum_y", "angular_momentum_z", "kinetic",
+        "potential", "elastic", "total_energy", "max_speed", "max_density_error"]
 
 # particles.png: the figure's bounds (inches), the room a panel needs beside its drawing (tick labels, title) and
 # the colour bar's width.
@@ -30,7 +34,8 @@ SPLASH_ROOM = 0.25  # the view extends past the container by at most this fracti
 
 def plot_series(folder, names, col):
     probes = [n for n in names if n not in BASE and not n.startswith("level_")]
-    panels = [("particles", ["fluid"]), ("energy (J/m)", ["kinetic", "potential", "total_energy"]),
+    energy = "energy (J)" if "momentum_z" in names else "energy (J/m)"  # a 2D run's energies are per metre of depth
+    panels = [("particles", ["fluid"]), (energy, ["kinetic", "potential", "total_energy"]),
               ("max |rho/rho0 - 1|", ["max_density_error"]), ("max |v| (m/s)", ["max_speed"])]
     panels += [(p, [p]) for p in probes]
     # The mass balance: fluid removed through an open top is counted, so (M + removed) / M0 - 1 stays at rounding.
@@ -70,10 +75,16 @@ def particle_layout(width, height, panels=4):
     return best
 
 
+def plane(v):
+    """The drawn coordinates of points or a corner: (x, y) in 2D, (x, z) in 3D (the side view)."""
+    v = np.asarray(v, dtype=float)
+    return v[..., [0, v.shape[-1] - 1]]
+
+
 def view_box(scene, snaps):
     """The box every panel shows: the container, extended (by at most SPLASH_ROOM of its size) to fluid outside it."""
-    lo = np.array(scene["container"]["lo"], dtype=float)
-    hi = np.array(scene["container"]["hi"], dtype=float)
+    lo = plane(scene["container"]["lo"])
+    hi = plane(scene["container"]["hi"])
     size = hi - lo
     fluid = [s["x"][s["kind"] == 0] for s in snaps]
     fluid = np.concatenate(fluid) if fluid else np.zeros((0, 2))
@@ -87,12 +98,12 @@ def view_box(scene, snaps):
 
 def draw_geometry(ax, scene):
     c = scene["container"]
-    (x0, y0), (x1, y1) = c["lo"], c["hi"]
+    (x0, y0), (x1, y1) = plane(c["lo"]), plane(c["hi"])
     ax.plot([x0, x0, x1, x1], [y1, y0, y0, y1], color="0.25", lw=1.2, zorder=3)  # left, bottom, right walls
     ax.plot([x0, x1], [y1, y1], color="0.25", lw=1.2 if not c.get("open_top", True) else 0.8,
             ls="-" if not c.get("open_top", True) else (0, (4, 3)), zorder=3)
     for o in scene.get("obstacles", []):
-        (a0, b0), (a1, b1) = o["lo"], o["hi"]
+        (a0, b0), (a1, b1) = plane(o["lo"]), plane(o["hi"])
         ax.add_patch(Rectangle((a0, b0), a1 - a0, b1 - b0, facecolor="0.75", edgecolor="0.25", lw=1.0, zorder=3))
 
 
@@ -103,8 +114,12 @@ def plot_particles(folder, scene, files):
         with h5py.File(os.path.join(folder, "frames", fn), "r") as h:
             g = h[list(h.keys())[0]]
             kind = g["kind"][...]
-            snaps.append({"t": float(g.attrs["time"]), "x": g["position"][...], "kind": kind,
-                          "speed": np.linalg.norm(g["velocity"][...], axis=1), "d": g["spacing"][...]})
+            x = g["position"][...]
+            # Drawn back to front: in 3D the particles nearest the low-y face (the viewer) last.
+            order = np.argsort(-x[:, 1], kind="stable") if x.shape[1] == 3 else np.arange(len(x))
+            snaps.append({"t": float(g.attrs["time"]), "x": plane(x)[order], "kind": kind[order],
+                          "speed": np.linalg.norm(g["velocity"][...], axis=1)[order], "d": g["spacing"][...][order],
+                          "dim": x.shape[1]})
     vmax = max([1e-9] + [float(np.max(s["speed"][s["kind"] == 0], initial=0.0)) for s in snaps])
     lo, hi = view_box(scene, snaps)
     rows, cols, pw, ph = particle_layout(*(hi - lo))
@@ -116,7 +131,7 @@ def plot_particles(folder, scene, files):
     sc = None
     for ax, s in zip(axes.flat, snaps):
         draw_geometry(ax, scene)
-        wall = s["kind"] == 1
+        wall = (s["kind"] == 1) & (s["dim"] == 2)
         ax.scatter(s["x"][wall, 0], s["x"][wall, 1], s=1, c="0.6", linewidths=0, zorder=2)
         fl = s["kind"] == 0
         # Each particle as wide as its spacing (area in points^2), so the fluid reads as a continuum at any scale.
@@ -131,7 +146,7 @@ def plot_particles(folder, scene, files):
     for ax in axes[-1, :]:
         ax.set_xlabel("x (m)", fontsize=8)
     for ax in axes[:, 0]:
-        ax.set_ylabel("y (m)", fontsize=8)
+        ax.set_ylabel("z (m)" if snaps[0]["dim"] == 3 else "y (m)", fontsize=8)
     fig.colorbar(sc, ax=axes, shrink=0.9 if rows > 1 else 1.0, label="|v| (m/s)", aspect=30)
     fig.suptitle(scene.get("name", ""), fontsize=10)
     fig.savefig(os.path.join(folder, "particles.png"), dpi=100)

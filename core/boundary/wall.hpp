@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "core/types.hpp"
@@ -165,6 +166,20 @@ struct Geometry {
     double best = std::numeric_limits<double>::infinity();
     for (const Wall<D>& w : walls()) best = std::min(best, (x - w.nearest_point(x)).norm());
     return best;
+  }
+};
+
+/// A box whose dimension is known only when a scene is read (AnyVec corners); `fixed<D>()` gives the solver's.
+struct AnyBox {
+  AnyVec lo, hi;
+  AnyBox() = default;
+  AnyBox(AnyVec lo_, AnyVec hi_) : lo(std::move(lo_)), hi(std::move(hi_)) {}
+  template <int D>
+  AnyBox(const Box<D>& b) : lo(b.lo), hi(b.hi) {}  // NOLINT: a Box<D> is an AnyBox
+  bool operator==(const AnyBox&) const = default;
+  template <int D>
+  Box<D> fixed() const {
+    return Box<D>{lo.fixed<D>(), hi.fixed<D>()};
   }
 };
 

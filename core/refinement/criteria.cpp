@@ -72,11 +72,7 @@ std::unique_ptr<CriterionIn<D>> make_criterion(const RefinementSettings& s) {
     case CriterionKind::velocity:
       return std::make_unique<VelocityCriterionIn<D>>(s.v_threshold, s.coarsening ? s.coarsening->v_threshold : 0.0);
     case CriterionKind::zone:
-      if constexpr (D == 2) {
-        return std::make_unique<ZoneCriterionIn<D>>(s.zone);
-      } else {
-        throw std::invalid_argument("refinement: the zone criterion takes a 2D box; a 3D zone is not in the settings yet");
-      }
+      return std::make_unique<ZoneCriterionIn<D>>(s.zone.fixed<D>());
     case CriterionKind::few_neighbours:
       return std::make_unique<FewNeighboursCriterionIn<D>>(s.min_neighbours,
                                                            s.coarsening ? s.coarsening->min_neighbours : 0);

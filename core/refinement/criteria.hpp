@@ -75,8 +75,7 @@ class FewNeighboursCriterionIn final : public CriterionIn<D> {
   int merge_min_;
 };
 
-/// The criterion the settings name. (The zone criterion is 2D only until the scene model carries a 3D zone:
-/// in 3D it throws std::invalid_argument.)
+/// The criterion the settings name. A zone of another dimension than D throws std::invalid_argument.
 template <int D = 2>
 std::unique_ptr<CriterionIn<D>> make_criterion(const RefinementSettings& s);
 

@@ -31,7 +31,7 @@ struct CoarseningSettings {
 struct RefinementSettings {
   CriterionKind criterion = CriterionKind::velocity;
   double v_threshold = 10.0;  // m/s
-  Box2 zone;
+  AnyBox zone;  // the scene's dimension
   int min_neighbours = 8;
   Pattern pattern = Pattern::aap;
   double rsp_k = 1.0;       // 1/2 as printed in the paper, 1 the consistent reading

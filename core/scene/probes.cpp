@@ -74,7 +74,8 @@ double water_height(const ParticleStore<2>& store, double x, double band, double
   return water_height<2>(store, Horizontal<2>::Constant(x), band, floor, gap);
 }
 
-double surge_front(const ParticleStore<2>& store, double origin, double gap) {
+template <int D>
+double surge_front(const ParticleStore<D>& store, double origin, double gap) {
   std::vector<std::pair<double, double>> xs;
   for (std::size_t i = 0; i < store.size(); ++i) {
     if (store.kind[i] == Kind::fluid) xs.emplace_back(store.x[i][0], 0.5 * store.d[i]);
@@ -101,9 +102,10 @@ Probes::Probes(const Scene& scene) {
   const double band = coarsest_spacing(scene);
   gap_ = band;
   for (const Probe& p : scene.probes) {
-    Resolved r{p.kind, p.x, p.band.value_or(band), 0.0, p.position};
+    AnyVec at = p.y ? AnyVec(Vec<2>(p.x, *p.y)) : AnyVec(Vec<1>::Constant(p.x));
+    Resolved r{p.kind, at, p.band.value_or(band), 0.0, p.position};
     switch (p.kind) {
-      case ProbeKind::water_height: r.reference = scene.container.box.lo[1]; break;
+      case ProbeKind::water_height: r.reference = scene.container.box.lo[dimension(scene) - 1]; break;
       case ProbeKind::surface_elevation: r.reference = p.datum; break;
       case ProbeKind::surge_front: r.reference = p.origin.value_or(scene.container.box.lo[0]); break;
       case ProbeKind::pressure: break;
@@ -113,19 +115,22 @@ Probes::Probes(const Scene& scene) {
   }
 }
 
-std::vector<double> Probes::measure(const ParticleStore<2>& store) const {
+template <int D>
+std::vector<double> Probes::measure(const ParticleStore<D>& store) const {
   std::vector<double> out;
   out.reserve(probes_.size());
   for (const Resolved& p : probes_) {
     switch (p.kind) {
-      case ProbeKind::water_height: out.push_back(water_height(store, p.x, p.band, p.reference, gap_)); break;
+      case ProbeKind::water_height:
+        out.push_back(water_height<D>(store, Horizontal<D>(p.at.data()), p.band, p.reference, gap_));
+        break;
       case ProbeKind::surface_elevation: {
-        const double top = column_top(store, p.x, p.band, gap_);
+        const double top = column_top<D>(store, Horizontal<D>(p.at.data()), p.band, gap_);
         out.push_back(std::isfinite(top) ? top - p.reference : std::numeric_limits<double>::quiet_NaN());
         break;
       }
-      case ProbeKind::surge_front: out.push_back(surge_front(store, p.reference, gap_)); break;
-      case ProbeKind::pressure: out.push_back(point_pressure(store, p.position)); break;
+      case ProbeKind::surge_front: out.push_back(surge_front<D>(store, p.reference, gap_)); break;
+      case ProbeKind::pressure: out.push_back(point_pressure<D>(store, p.position.fixed<D>())); break;
     }
   }
   return out;
@@ -133,6 +138,10 @@ std::vector<double> Probes::measure(const ParticleStore<2>& store) const {
 
 template double water_height<2>(const ParticleStore<2>&, const Horizontal<2>&, double, double, double);
 template double water_height<3>(const ParticleStore<3>&, const Horizontal<3>&, double, double, double);
+template double surge_front<2>(const ParticleStore<2>&, double, double);
+template double surge_front<3>(const ParticleStore<3>&, double, double);
+template std::vector<double> Probes::measure<2>(const ParticleStore<2>&) const;
+template std::vector<double> Probes::measure<3>(const ParticleStore<3>&) const;
 template double point_pressure<2>(const ParticleStore<2>&, const Vec<2>&);
 template double point_pressure<3>(const ParticleStore<3>&, const Vec<3>&);
 

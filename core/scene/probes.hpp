@@ -31,7 +31,9 @@ using Horizontal = Vec<D - 1>;
 template <int D>
 double water_height(const ParticleStore<D>& store, const Horizontal<D>& at, double band, double floor, double gap);
 double water_height(const ParticleStore<2>& store, double x, double band, double floor, double gap);
-double surge_front(const ParticleStore<2>& store, double origin, double gap);
+/// The surge front along x, over every fluid particle (2D or 3D).
+template <int D>
+double surge_front(const ParticleStore<D>& store, double origin, double gap);
 /// The pressure at a point (a sensor on a wall: the ghosts across the wall take part), in 2D or 3D.
 template <int D>
 double point_pressure(const ParticleStore<D>& store, const Vec<D>& point);
@@ -40,14 +42,16 @@ class Probes {
  public:
   explicit Probes(const Scene& scene);
   const std::vector<std::string>& names() const { return names_; }
-  /// One value per probe, in scene order.
-  std::vector<double> measure(const ParticleStore<2>& store) const;
+  /// One value per probe, in scene order (D the scene's dimension).
+  template <int D>
+  std::vector<double> measure(const ParticleStore<D>& store) const;
 
  private:
   struct Resolved {
     ProbeKind kind;
-    double x, band, reference;
-    Vec<2> position;
+    AnyVec at;  // a gauge's horizontal position: x in 2D, (x, y) in 3D
+    double band, reference;
+    AnyVec position;
   };
   std::vector<Resolved> probes_;
   double gap_ = 0.0;  // one coarse spacing: a wider empty space separates splash from the body of water

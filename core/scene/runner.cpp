@@ -48,11 +48,12 @@ Json physics_of(const Scene& s) {
 
 }  // namespace
 
-Runner::Runner(Scene scene, RunOptions options)
+template <int D>
+RunnerT<D>::RunnerT(Scene scene, RunOptions options)
     : scene_(std::move(scene)),
       options_(std::move(options)),
       files_{options_.folder},
-      sim_(build_simulation(scene_)),
+      sim_(build_simulation<D>(scene_)),
       probes_(scene_) {
   if (options_.resume) {
     io::CheckpointState state = io::read_checkpoint(*options_.resume, sim_.store());
@@ -80,7 +81,9 @@ Runner::Runner(Scene scene, RunOptions options)
     next_checkpoint_ = state.next_checkpoint;
     particle_steps_ = state.particle_steps;
     initial_mass_ = state.initial_mass;
-    initial_momentum_ = Vec<2>(state.initial_momentum_x, state.initial_momentum_y);
+    initial_momentum_[0] = state.initial_momentum_x;
+    initial_momentum_[1] = state.initial_momentum_y;
+    if constexpr (D == 3) initial_momentum_[2] = state.initial_momentum_z;
     RemovedFluid removed;
     removed.particles = state.removed_particles;
     removed.mass.sum = state.removed_mass;
@@ -89,7 +92,7 @@ Runner::Runner(Scene scene, RunOptions options)
     last_row_step_ = last_frame_step_ = last_checkpoint_step_ = state.step;
     resumed_ = true;
   } else {
-    const Diagnostics d = sim_.diagnostics();
+    const DiagnosticsT<D> d = sim_.diagnostics();
     initial_mass_ = d.mass;
     initial_momentum_ = d.momentum;
   }
@@ -99,33 +102,47 @@ Runner::Runner(Scene scene, RunOptions options)
   }
 }
 
-void Runner::fit_threads(std::size_t fluid) {
+template <int D>
+void RunnerT<D>::fit_threads(std::size_t fluid) {
   if (thread_limit_ > 0) omp_set_num_threads(par::threads_for(fluid, thread_limit_));
 }
 
-Runner::~Runner() = default;
+template <int D>
+RunnerT<D>::~RunnerT() = default;
 
-bool Runner::finished() const { return !(sim_.time() < scene_.time.end * (1.0 - 1e-14)); }
+template <int D>
+bool RunnerT<D>::finished() const { return !(sim_.time() < scene_.time.end * (1.0 - 1e-14)); }
 
-std::vector<std::string> Runner::columns() const {
+template <int D>
+std::vector<std::string> RunnerT<D>::columns() const {
   std::vector<std::string> c{"time", "step", "dt", "fluid", "ghosts", "walls"};
   for (int l = 0; l <= finest_level(scene_); ++l) c.push_back("level_" + std::to_string(l));
-  for (const char* name : {"mass", "removed", "removed_mass", "momentum_x", "momentum_y", "angular_momentum", "kinetic", "potential", "elastic",
-                           "total_energy", "max_speed", "max_density_error"}) {
+  for (const char* name : {"mass", "removed", "removed_mass"}) c.emplace_back(name);
+  const char* axes[] = {"x", "y", "z"};
+  for (int a = 0; a < D; ++a) c.push_back(std::string("momentum_") + axes[a]);
+  // Angular momentum about the origin: its z component in 2D, the vector in 3D.
+  if constexpr (D == 2) {
+    c.emplace_back("angular_momentum");
+  } else {
+    for (int a = 0; a < D; ++a) c.push_back(std::string("angular_momentum_") + axes[a]);
+  }
+  for (const char* name : {"kinetic", "potential", "elastic", "total_energy", "max_speed", "max_density_error"}) {
     c.emplace_back(name);
   }
   for (const auto& n : probes_.names()) c.push_back(n);
   return c;
 }
 
-std::size_t Runner::fluid_count() const {
+template <int D>
+std::size_t RunnerT<D>::fluid_count() const {
   const auto& kind = sim_.store().kind.values();
   std::size_t n = 0;
   for (const Kind k : kind) n += k == Kind::fluid ? 1 : 0;
   return n;
 }
 
-void Runner::start() {
+template <int D>
+void RunnerT<D>::start() {
   if (started_) return;
   started_ = true;
   wall_start_ = now_seconds();
@@ -153,7 +170,8 @@ void Runner::start() {
   write_due_outputs(false);
 }
 
-void Runner::advance() {
+template <int D>
+void RunnerT<D>::advance() {
   if (!started_) start();
   const double t0 = sim_.time();
   const double remaining = scene_.time.end - t0;
@@ -189,7 +207,8 @@ void Runner::advance() {
   write_due_outputs(false);
 }
 
-void Runner::write_due_outputs(bool final) {
+template <int D>
+void RunnerT<D>::write_due_outputs(bool final) {
   if (options_.folder.empty()) return;
   const double t = sim_.time();
   const std::uint64_t step = sim_.step_count();
@@ -211,16 +230,23 @@ void Runner::write_due_outputs(bool final) {
   }
 }
 
-void Runner::write_row() {
-  const Diagnostics d = sim_.diagnostics();
+template <int D>
+void RunnerT<D>::write_row() {
+  const DiagnosticsT<D> d = sim_.diagnostics();
   std::vector<double> row{d.time, static_cast<double>(d.step), d.dt, static_cast<double>(d.fluid),
                           static_cast<double>(d.ghosts), static_cast<double>(d.walls)};
   for (int l = 0; l <= finest_level(scene_); ++l) {
     const auto k = static_cast<std::size_t>(l);
     row.push_back(k < d.per_level.size() ? static_cast<double>(d.per_level[k]) : 0.0);
   }
-  for (const double v : {d.mass, static_cast<double>(d.removed), d.removed_mass, d.momentum[0], d.momentum[1], d.angular_momentum, d.kinetic, d.potential, d.elastic,
-                         d.total_energy(), d.max_speed, d.max_density_error}) {
+  for (const double v : {d.mass, static_cast<double>(d.removed), d.removed_mass}) row.push_back(v);
+  for (int a = 0; a < D; ++a) row.push_back(d.momentum[a]);
+  if constexpr (D == 2) {
+    row.push_back(d.angular_momentum);
+  } else {
+    for (int a = 0; a < D; ++a) row.push_back(d.angular_momentum[a]);
+  }
+  for (const double v : {d.kinetic, d.potential, d.elastic, d.total_energy(), d.max_speed, d.max_density_error}) {
     row.push_back(v);
   }
   for (const double v : probes_.measure(sim_.store())) row.push_back(v);
@@ -229,7 +255,8 @@ void Runner::write_row() {
   ++rows_;
 }
 
-void Runner::write_frame() {
+template <int D>
+void RunnerT<D>::write_frame() {
   const std::uint64_t index = frame_count_;
   const io::FrameHeader h = io::write_frame(files_.frame(index), io::RunFiles::frame_group(index), sim_.store(),
                                             sim_.time(), sim_.step_count(), index, scene_.output.fields);
@@ -240,7 +267,8 @@ void Runner::write_frame() {
   ++frames_written_;
 }
 
-void Runner::write_checkpoint() {
+template <int D>
+void RunnerT<D>::write_checkpoint() {
   io::CheckpointState s;
   s.time = sim_.time();
   s.step = sim_.step_count();
@@ -255,6 +283,7 @@ void Runner::write_checkpoint() {
   s.initial_mass = initial_mass_;
   s.initial_momentum_x = initial_momentum_[0];
   s.initial_momentum_y = initial_momentum_[1];
+  if constexpr (D == 3) s.initial_momentum_z = initial_momentum_[2];
   s.removed_particles = sim_.removed().particles;
   s.removed_mass = sim_.removed().mass.sum;
   s.removed_mass_compensation = sim_.removed().mass.c;
@@ -264,8 +293,9 @@ void Runner::write_checkpoint() {
   ++checkpoints_;
 }
 
-RunSummary Runner::summary() const {
-  RunSummary r;
+template <int D>
+typename RunnerT<D>::Summary RunnerT<D>::summary() const {
+  Summary r;
   r.wall_seconds = now_seconds() - wall_start_;
   r.steps = steps_run_;
   r.particle_steps = particle_steps_;
@@ -281,7 +311,8 @@ RunSummary Runner::summary() const {
   return r;
 }
 
-void Runner::write_summary(const RunSummary& r, const FailureReport* failure) {
+template <int D>
+void RunnerT<D>::write_summary(const Summary& r, const FailureReport* failure) {
   if (options_.folder.empty()) return;
   Json j;
   j["scene"] = scene_.name;
@@ -291,6 +322,7 @@ void Runner::write_summary(const RunSummary& r, const FailureReport* failure) {
   j["threads_rule"] = thread_limit_ > 0 ? "one per " + std::to_string(par::kMinItemsPerThread) +
                                               " fluid particles, at most " + std::to_string(thread_limit_)
                                         : std::string("as set");
+  j["dimension"] = D;
   j["sweep"] = sim_.sweep_name();
   j["resumed"] = resumed_;
   j["status"] = failure ? "failed" : "completed";
@@ -337,7 +369,8 @@ void Runner::write_summary(const RunSummary& r, const FailureReport* failure) {
   io::write_file_atomic(files_.summary(), j.dump(2) + "\n");
 }
 
-void Runner::fail(const FailureReport& report) {
+template <int D>
+void RunnerT<D>::fail(const FailureReport& report) {
   std::string where;
   if (!options_.folder.empty()) {
     // The simulation holds the last good state: leave it behind, complete, for inspection and --resume.
@@ -358,15 +391,17 @@ void Runner::fail(const FailureReport& report) {
   throw RunFailure(report.message() + "." + where, report);
 }
 
-RunSummary Runner::finish() {
+template <int D>
+typename RunnerT<D>::Summary RunnerT<D>::finish() {
   if (!started_) start();
   write_due_outputs(true);
-  const RunSummary r = summary();
+  const Summary r = summary();
   write_summary(r, nullptr);
   return r;
 }
 
-RunSummary Runner::run(const std::function<void(const Progress&)>& on_step) {
+template <int D>
+typename RunnerT<D>::Summary RunnerT<D>::run(const std::function<void(const Progress&)>& on_step) {
   start();
   while (!finished()) {
     advance();
@@ -377,5 +412,8 @@ RunSummary Runner::run(const std::function<void(const Progress&)>& on_step) {
   }
   return finish();
 }
+
+template class RunnerT<2>;
+template class RunnerT<3>;
 
 }  // namespace sph::scene

@@ -64,29 +64,35 @@ class RunFailure : public std::runtime_error {
   FailureReport report_;
 };
 
-struct RunSummary {
+template <int D>
+struct RunSummaryT {
   double wall_seconds = 0.0;
   std::uint64_t steps = 0;           // taken by this invocation
   std::uint64_t particle_steps = 0;  // sum over those steps of the fluid particle count
-  Diagnostics final;
+  DiagnosticsT<D> final;
   double initial_mass = 0.0;
-  Vec<2> initial_momentum = Vec<2>::Zero();
+  Vec<D> initial_momentum = Vec<D>::Zero();
   double mass_drift = 0.0;      // (M + removed mass - M0) / M0: fluid removed through the open top is accounted
   double momentum_change = 0.0; // |P - P0| (kg m/s); walls and gravity change it physically
   std::uint64_t rows = 0, frames = 0, checkpoints = 0;
 };
+using RunSummary = RunSummaryT<2>;
 
-class Runner {
+/// The runner of a scene of dimension D (with_dimension picks it; the constructor refuses another).
+template <int D>
+class RunnerT {
  public:
+  using Summary = RunSummaryT<D>;
+
   /// Builds the simulation (or loads the checkpoint). Does not create the folder: call start().
-  Runner(Scene scene, RunOptions options);
-  ~Runner();
-  Runner(const Runner&) = delete;
-  Runner& operator=(const Runner&) = delete;
+  RunnerT(Scene scene, RunOptions options);
+  ~RunnerT();
+  RunnerT(const RunnerT&) = delete;
+  RunnerT& operator=(const RunnerT&) = delete;
 
   const Scene& scene() const { return scene_; }
-  Simulation& simulation() { return sim_; }
-  const Simulation& simulation() const { return sim_; }
+  SimulationT<D>& simulation() { return sim_; }
+  const SimulationT<D>& simulation() const { return sim_; }
   double end_time() const { return scene_.time.end; }
   bool finished() const;
 
@@ -96,9 +102,9 @@ class Runner {
   /// (after writing the last good state), std::runtime_error if the run diverges otherwise.
   void advance();
   /// The last outputs, a checkpoint if requested, run.json; returns the summary.
-  RunSummary finish();
+  Summary finish();
   /// start(), advance() until the end (calling on_step after each step), finish().
-  RunSummary run(const std::function<void(const Progress&)>& on_step = {});
+  Summary run(const std::function<void(const Progress&)>& on_step = {});
 
   /// The time-series column names.
   std::vector<std::string> columns() const;
@@ -108,8 +114,8 @@ class Runner {
   void write_row();
   void write_frame();
   void write_checkpoint();
-  RunSummary summary() const;
-  void write_summary(const RunSummary& r, const FailureReport* failure);
+  Summary summary() const;
+  void write_summary(const Summary& r, const FailureReport* failure);
   [[noreturn]] void fail(const FailureReport& report);
   std::size_t fluid_count() const;
   void fit_threads(std::size_t fluid);
@@ -117,7 +123,7 @@ class Runner {
   Scene scene_;
   RunOptions options_;
   io::RunFiles files_;
-  Simulation sim_;
+  SimulationT<D> sim_;
   Probes probes_;
   std::unique_ptr<io::TimeSeriesWriter> series_;
   std::vector<io::XdmfEntry> frames_;
@@ -127,11 +133,14 @@ class Runner {
   std::size_t last_fluid_ = 0;  // fluid particles after the last step
   int thread_limit_ = 0;        // threads_from_work: the most threads the runner may use
   double initial_mass_ = 0.0;
-  Vec<2> initial_momentum_ = Vec<2>::Zero();
+  Vec<D> initial_momentum_ = Vec<D>::Zero();
   bool resumed_ = false;
   bool final_step_shortened_ = false;  // the checkpoint holds the state before the shortened last step
   bool started_ = false;
   double wall_start_ = 0.0;
 };
+
+using Runner = RunnerT<2>;
+using Runner3 = RunnerT<3>;
 
 }  // namespace sph::scene

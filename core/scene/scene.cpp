@@ -19,10 +19,13 @@ namespace sph::scene {
 
 double FluidRegion::lattice_spacing() const { return spacing / std::pow(2.0, level); }
 
+int dimension(const Scene& s) { return s.container.box.lo.size() == 3 ? 3 : 2; }
+
 double gravity_magnitude(const Scene& s) {
-  if (!s.effects.gravity) return 0.0;
-  const Vec<2>& g = *s.effects.gravity;
-  return g[0] == 0.0 ? std::abs(g[1]) : g.norm();
+  if (!s.effects.gravity || s.effects.gravity->size() == 0) return 0.0;
+  const AnyVec& g = *s.effects.gravity;
+  const Eigen::Index up = g.size() - 1;
+  return g.head(up).isZero(0.0) ? std::abs(g[up]) : g.norm();
 }
 
 double sound_speed(const Scene& s) {
@@ -70,36 +73,57 @@ double estimated_particles(const Scene& s) { return estimated_fluid_particles(s)
 double estimated_fluid_particles(const Scene& s) {
   double fluid = 0.0;
   for (const auto& f : s.fluid) fluid += estimated_particles(f);
-  return s.effects.static_refinement ? 4.0 * fluid : fluid;
+  // A static refinement pass splits each particle into 2^D daughters.
+  return s.effects.static_refinement ? std::pow(2.0, dimension(s)) * fluid : fluid;
 }
 
-double wall_length(const Scene& s) {
-  double length = 0.0;
-  for (const Wall2& w : solver_settings(s).geometry.walls()) length += w.span();
-  return length;
+namespace {
+
+/// For each wall face of the scene, the product over its in-plane axes of f(extent along that axis).
+template <class F>
+double sum_over_walls(const Scene& s, F per_axis) {
+  return with_dimension(s, [&](auto dim) {
+    constexpr int D = decltype(dim)::value;
+    double total = 0.0;
+    for (const Wall<D>& w : solver_settings<D>(s).geometry.walls()) {
+      double face = 1.0;
+      for (int a = 0; a < D; ++a)
+        if (a != w.axis) face *= per_axis(w.hi[a] - w.lo[a]);
+      total += face;
+    }
+    return total;
+  });
+}
+
+}  // namespace
+
+double wall_size(const Scene& s) {
+  return sum_over_walls(s, [](double extent) { return extent; });
 }
 
 double estimated_wall_particles(const Scene& s) {
   if (!s.effects.lennard_jones_wall) return 0.0;
-  // Along each wall, one particle every wall spacing from end to end: ceil(length / spacing) + 1 of them.
-  const double walls = static_cast<double>(solver_settings(s).geometry.walls().size());
-  return wall_length(s) / wall_spacing(s) + 2.0 * walls;
+  // On each face, one particle every wall spacing from edge to edge: ceil(extent / spacing) + 1 of them along
+  // each of its in-plane axes; extent / spacing + 2 is a little above it.
+  const double ws = wall_spacing(s);
+  return sum_over_walls(s, [ws](double extent) { return extent / ws + 2.0; });
 }
 
 double estimated_ghost_particles(const Scene& s) {
   if (!s.effects.ghost_walls) return 0.0;
   // A wall mirrors the particles within 2 h = 2 h_factor d of it (and projecting onto it); on the starting
-  // lattices that is at most ceil(2 h_factor) rows of length / d + 1 particles, d the finest starting lattice
-  // spacing (halved by a static refinement pass). A particle near two perpendicular walls also gets a corner
-  // image: at most rows^2 of them at each corner, and there are no more corners than walls. No particle has
-  // more than GhostBuilder::kMaxGhosts images.
+  // lattices that is at most rows = ceil(2 h_factor) layers of (extent / d + 1) particles along each in-plane
+  // axis, d the finest starting lattice spacing (halved by a static refinement pass). Particles near two or
+  // three perpendicular walls also get edge and corner images: widening each face by `rows` along each of its
+  // axes counts them, since there are no more edges or corners at a face than it has sides. No particle has
+  // more than kMaxGhosts images (GhostBuilderT).
   double d = std::numeric_limits<double>::infinity();
   for (const auto& f : s.fluid) d = std::min(d, f.lattice_spacing());
   if (s.effects.static_refinement) d /= 2.0;
   const double rows = std::ceil(2.0 * s.h_factor);
-  double bound = 0.0;
-  for (const Wall2& w : solver_settings(s).geometry.walls()) bound += (w.span() / d + 1.0) * rows + rows * rows;
-  return std::min(bound, GhostBuilder::kMaxGhosts * estimated_fluid_particles(s));
+  const double bound = rows * sum_over_walls(s, [&](double extent) { return extent / d + 1.0 + rows; });
+  const double most_images = dimension(s) == 3 ? GhostBuilderT<3>::kMaxGhosts : GhostBuilderT<2>::kMaxGhosts;
+  return std::min(bound, most_images * estimated_fluid_particles(s));
 }
 
 double lennard_jones_strength(const Scene& s) {
@@ -119,11 +143,14 @@ MemoryEstimate estimated_memory(const Scene& s, int threads) {
   // The cell grid adds its order, keys and cells (CellGrid::bytes_bound: cells at the full budget).
   // This is the start. Dynamic refinement splits particles into four as the run goes (up to the scene's
   // max_level) and grows all of it; outputs take a field's worth more while they write.
-  constexpr double per_particle = 3.0 * ParticleStore<2>::bytes_per_particle() + 3.0 * sizeof(std::uint32_t) +
-                                  2.0 * sizeof(std::int8_t) + sizeof(Vec<2>);
   const double n = estimated_fluid_particles(s) + estimated_ghost_particles(s) + estimated_wall_particles(s);
-  const auto grid = static_cast<double>(CellGrid<2>::bytes_bound(static_cast<std::size_t>(std::min(n, 1e15)), threads));
-  return {n, n * per_particle + grid};
+  return with_dimension(s, [&](auto dim) {
+    constexpr int D = decltype(dim)::value;
+    constexpr double per_particle = 3.0 * ParticleStore<D>::bytes_per_particle() + 3.0 * sizeof(std::uint32_t) +
+                                    2.0 * sizeof(std::int8_t) + sizeof(Vec<D>);
+    const auto grid = static_cast<double>(CellGrid<D>::bytes_bound(static_cast<std::size_t>(std::min(n, 1e15)), threads));
+    return MemoryEstimate{n, n * per_particle + grid};
+  });
 }
 
 namespace {
@@ -187,9 +214,12 @@ std::vector<std::string> particle_field_names() {
 double estimated_particles(const FluidRegion& f) {
   const double d = f.lattice_spacing();
   if (f.shape == Shape::rectangle) {
-    return std::floor((f.rect.hi[0] - f.rect.lo[0]) / d + 1e-9) * std::floor((f.rect.hi[1] - f.rect.lo[1]) / d + 1e-9);
+    double n = 1.0;
+    for (Eigen::Index a = 0; a < f.rect.lo.size(); ++a) n *= std::floor((f.rect.hi[a] - f.rect.lo[a]) / d + 1e-9);
+    return n;
   }
-  return std::numbers::pi * (f.radius / d + 1.0) * (f.radius / d + 1.0);
+  const double r = f.radius / d + 1.0;
+  return f.centre.size() == 3 ? 4.0 / 3.0 * std::numbers::pi * r * r * r : std::numbers::pi * r * r;
 }
 
 }  // namespace sph::scene

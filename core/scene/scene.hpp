@@ -5,6 +5,7 @@
 // ready Simulation. An effect absent from the scene is std::nullopt here and is not computed.
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "core/boundary/ghosts.hpp"
@@ -15,8 +16,12 @@
 
 namespace sph::scene {
 
-/// Axis-aligned rectangle [lo, hi] (m): the solver's box.
-using Rect = Box2;
+/// The scene's dimension, 2 or 3, is the container's: the number of coordinates of its corners. Every point and
+/// vector of the scene has that many ("up" is the last axis: y in 2D, z in 3D), and is held as an AnyVec (an
+/// absent vector with a zero default is empty) until the solver of that dimension is built.
+
+/// Axis-aligned box [lo, hi] (m): a rectangle in 2D, a cuboid in 3D.
+using Rect = AnyBox;
 
 struct Container {
   Rect box;
@@ -27,17 +32,18 @@ struct Container {
 
 enum class Shape { rectangle, circle };
 
-/// A block of fluid filled with a square lattice (particles at cell centres).
+/// A block of fluid filled with a square (cubic in 3D) lattice, particles at cell centres. A "circle" is a disc
+/// in 2D and a ball in 3D.
 struct FluidRegion {
   Shape shape = Shape::rectangle;
   Rect rect;                           // rectangle
-  Vec<2> centre = Vec<2>::Zero();      // circle
+  AnyVec centre;                       // circle
   double radius = 0.0;                 // circle (m)
   double spacing = 0.0;                // d^0: the level-0 spacing (m); the lattice is d^0 / 2^level
   int level = 0;                       // initial refinement level of the region's particles
-  Vec<2> velocity = Vec<2>::Zero();    // initial velocity (m/s)
-  bool hydrostatic = false;            // hydrostatic initial density (needs gravity along -y)
-  std::optional<double> surface;       // y of the free surface for the hydrostatic start (default: top)
+  AnyVec velocity;                     // initial velocity (m/s); empty: at rest
+  bool hydrostatic = false;            // hydrostatic initial density (needs gravity along -up)
+  std::optional<double> surface;       // height of the free surface for the hydrostatic start (default: top)
   bool operator==(const FluidRegion&) const = default;
 
   double lattice_spacing() const;
@@ -91,7 +97,7 @@ struct StaticRefinement {
 };
 
 struct Effects {
-  std::optional<Vec<2>> gravity;
+  std::optional<AnyVec> gravity;
   std::optional<ArtificialViscosity> artificial_viscosity;
   std::optional<ArtificialStress> artificial_stress;
   std::optional<DensityDiffusion> density_diffusion;
@@ -121,10 +127,11 @@ struct Probe {
   ProbeKind kind = ProbeKind::water_height;
   std::string name;
   double x = 0.0;                       // water_height, surface_elevation: the column sampled
+  std::optional<double> y;              // its y in 3D (a gauge is the vertical line at (x, y)); not in 2D
   std::optional<double> band;           // half-width of the sampled column (default: largest d^0)
   std::optional<double> origin;         // surge_front: where Z is measured from (default container lo.x)
   double datum = 0.0;                   // surface_elevation: elevation measured from this y
-  Vec<2> position = Vec<2>::Zero();     // pressure
+  AnyVec position;                      // pressure
   bool operator==(const Probe&) const = default;
 };
 
@@ -153,7 +160,15 @@ struct Scene {
 
 // Quantities derived from a scene (the rules are in docs/SCENES.md).
 
-/// |g| along -y used for hydrostatic starts and reference heights (0 without gravity).
+/// The scene's dimension: 2 or 3 (the container's coordinates).
+int dimension(const Scene& s);
+/// Calls f(std::integral_constant<int, D>{}) with D the scene's dimension, and returns what it returns.
+template <class F>
+decltype(auto) with_dimension(const Scene& s, F&& f) {
+  if (dimension(s) == 3) return f(std::integral_constant<int, 3>{});
+  return f(std::integral_constant<int, 2>{});
+}
+/// |g| along -up used for hydrostatic starts and reference heights (0 without gravity).
 double gravity_magnitude(const Scene& s);
 /// The sound speed c0 the scene resolves to.
 double sound_speed(const Scene& s);
@@ -176,9 +191,9 @@ double estimated_fluid_particles(const Scene& s);
 double estimated_wall_particles(const Scene& s);
 /// An upper bound on the ghost particles at the start (0 without ghost walls), from the walls' lengths.
 double estimated_ghost_particles(const Scene& s);
-/// The total length of the walls (m): the container's bottom and sides (and top when closed), every
-/// obstacle's four faces.
-double wall_length(const Scene& s);
+/// The total size of the walls: their length in 2D (m), their area in 3D (m^2). The container's bottom and sides
+/// (and top when closed), every obstacle's faces.
+double wall_size(const Scene& s);
 
 /// What a run of the scene holds in memory at its start: particles (fluid, ghosts, walls) and bytes.
 struct MemoryEstimate {

@@ -4,15 +4,20 @@
 #include "core/refinement/refinement_stage.hpp"
 #include "core/setup.hpp"
 
+#include <stdexcept>
+#include <string>
+
 namespace sph::scene {
 
-SolverSettings solver_settings(const Scene& scene) {
-  SolverSettings s;
+template <int D>
+SolverSettingsT<D> solver_settings(const Scene& scene) {
+  SolverSettingsT<D> s;
   s.eos.rho0 = scene.material.rho0;
   s.eos.gamma = scene.material.gamma;
   s.eos.c0 = sound_speed(scene);
   const Effects& e = scene.effects;
-  s.gravity = e.gravity;
+  s.gravity.reset();
+  if (e.gravity) s.gravity = e.gravity->fixed<D>();
   s.viscosity = e.artificial_viscosity;
   s.artificial_stress = e.artificial_stress;
   s.density_diffusion = e.density_diffusion;
@@ -22,33 +27,41 @@ SolverSettings solver_settings(const Scene& scene) {
   }
   s.ghosts = e.ghost_walls;
   s.ghost_pressure = e.ghost_pressure;
-  s.geometry.container = scene.container.box;
+  s.geometry.container = scene.container.box.fixed<D>();
   s.geometry.open_top = scene.container.open_top;
   s.geometry.outflow = scene.container.outflow;
-  s.geometry.obstacles = scene.obstacles;
+  s.geometry.obstacles.clear();
+  for (const Rect& o : scene.obstacles) s.geometry.obstacles.push_back(o.fixed<D>());
   s.cfl = scene.time.cfl;
   s.dt_max = scene.time.dt_max;
   s.stepping = scene.time.stepping;
   return s;
 }
 
-Simulation build_simulation(const Scene& scene) {
-  const SolverSettings settings = solver_settings(scene);
-  Simulation sim(settings);
-  ParticleStore<2>& store = sim.store();
+template <int D>
+SimulationT<D> build_simulation(const Scene& scene) {
+  if (dimension(scene) != D) {
+    throw std::invalid_argument("build_simulation<" + std::to_string(D) + ">: the scene is " +
+                                std::to_string(dimension(scene)) + "D");
+  }
+  const SolverSettingsT<D> settings = solver_settings<D>(scene);
+  SimulationT<D> sim(settings);
+  ParticleStore<D>& store = sim.store();
   const double g = gravity_magnitude(scene);
+  constexpr int up = D - 1;
   for (const FluidRegion& f : scene.fluid) {
     const double d = f.lattice_spacing();
-    const std::vector<Vec<2>> points = f.shape == Shape::rectangle ? lattice_rectangle(f.rect.lo, f.rect.hi, d)
-                                                                  : lattice_circle(f.centre, f.radius, d);
-    FluidBlockSpec block;
+    const std::vector<Vec<D>> points = f.shape == Shape::rectangle
+                                           ? lattice_block<D>(f.rect.lo.fixed<D>(), f.rect.hi.fixed<D>(), d)
+                                           : lattice_round<D>(f.centre.fixed<D>(), f.radius, d);
+    FluidBlockSpecT<D> block;
     block.spacing = d;
     block.h_factor = scene.h_factor;
     block.level = f.level;
-    block.velocity = f.velocity;
+    block.velocity = f.velocity.fixed<D>();
     const std::size_t first = add_fluid(store, points, block, settings.eos.rho0);
     if (f.hydrostatic) {
-      const double surface = f.surface.value_or(f.shape == Shape::rectangle ? f.rect.hi[1] : f.centre[1] + f.radius);
+      const double surface = f.surface.value_or(f.shape == Shape::rectangle ? f.rect.hi[up] : f.centre[up] + f.radius);
       set_hydrostatic(store, first, store.size(), surface, g, settings.eos);
     }
   }
@@ -58,7 +71,7 @@ Simulation build_simulation(const Scene& scene) {
   sim.refresh();
   if (const auto& st = scene.effects.static_refinement) {
     if (st->box) {
-      refine::refine_region(sim, *st->box, st->pattern, st->rsp_k);
+      refine::refine_region(sim, st->box->fixed<D>(), st->pattern, st->rsp_k);
     } else {
       refine::refine_all(sim, st->pattern, st->rsp_k);
     }
@@ -66,5 +79,10 @@ Simulation build_simulation(const Scene& scene) {
   if (scene.effects.refinement) refine::add_refinement_stage(sim, *scene.effects.refinement);
   return sim;
 }
+
+template SolverSettingsT<2> solver_settings<2>(const Scene&);
+template SolverSettingsT<3> solver_settings<3>(const Scene&);
+template SimulationT<2> build_simulation<2>(const Scene&);
+template SimulationT<3> build_simulation<3>(const Scene&);
 
 }  // namespace sph::scene

@@ -7,10 +7,13 @@
 
 namespace sph::scene {
 
-/// The solver settings a scene asks for.
-SolverSettings solver_settings(const Scene& scene);
+/// The solver settings a scene asks for, in the scene's dimension D (the caller picks it: with_dimension).
+template <int D = 2>
+SolverSettingsT<D> solver_settings(const Scene& scene);
 
-/// A Simulation at t = 0, rates evaluated and dt set (the scene must have passed validate_scene()).
-Simulation build_simulation(const Scene& scene);
+/// A simulation at t = 0, rates evaluated and dt set (the scene must have passed validate_scene(), and D must be
+/// its dimension).
+template <int D = 2>
+SimulationT<D> build_simulation(const Scene& scene);
 
 }  // namespace sph::scene

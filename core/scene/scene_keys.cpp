@@ -21,12 +21,13 @@ const S<Container>& container_section() {
     d.add(value<Container>("lo", [](auto& c) -> auto& { return c.box.lo; })
               .required()
               .unit("m")
-              .means("lower-left corner"));
+              .note("its two or three numbers make the scene 2D or 3D")
+              .means("lowest corner"));
     d.add(value<Container>("hi", [](auto& c) -> auto& { return c.box.hi; })
               .required()
               .unit("m")
-              .note("greater than `lo` in x and y")
-              .means("upper-right corner"));
+              .note("greater than `lo` on every axis")
+              .means("highest corner"));
     d.add(value<Container>("open_top", member(&Container::open_top)).means("false adds a wall along the top"));
     d.add(value<Container>("outflow", member(&Container::outflow))
               .note("`remove` needs `open_top`")
@@ -48,19 +49,19 @@ const S<FluidRegion>& region_section() {
               .only_for({"rectangle"})
               .unit("m")
               .note("inside the container, outside every obstacle")
-              .means("lower-left corner"));
+              .means("lowest corner"));
     d.add(value<FluidRegion>("hi", [](auto& f) -> auto& { return f.rect.hi; })
               .required()
               .only_for({"rectangle"})
               .unit("m")
-              .note("greater than `lo` in x and y")
-              .means("upper-right corner"));
+              .note("greater than `lo` on every axis")
+              .means("highest corner"));
     d.add(value<FluidRegion>("centre", member(&FluidRegion::centre))
               .required()
               .only_for({"circle"})
               .unit("m")
               .note("the circle inside the container, outside every obstacle")
-              .means("centre; the lattice passes through it"));
+              .means("centre (a disc in 2D, a ball in 3D); the lattice passes through it"));
     d.add(value<FluidRegion>("radius", member(&FluidRegion::radius))
               .required()
               .only_for({"circle"})
@@ -77,8 +78,8 @@ const S<FluidRegion>& region_section() {
               .means("initial level: the lattice spacing is `spacing / 2^level`"));
     d.add(value<FluidRegion>("velocity", member(&FluidRegion::velocity)).unit("m/s").means("initial velocity"));
     d.add(value<FluidRegion>("hydrostatic", member(&FluidRegion::hydrostatic))
-              .note("needs `effects.gravity` = [0, -g]")
-              .means("density from `p = rho0 g (surface - y)` through the equation of state; otherwise `rho = rho0`"));
+              .note("needs `effects.gravity` = [0, -g] (2D) or [0, 0, -g] (3D)")
+              .means("density from `p = rho0 g (surface - height)` through the equation of state; otherwise `rho = rho0`"));
     d.add(value<FluidRegion>("surface", member(&FluidRegion::surface))
               .unit("m")
               .default_text("the rectangle's top")
@@ -166,17 +167,22 @@ const S<Probe>& probe_section() {
               .only_for(column)
               .unit("m")
               .note("within the container's x range")
-              .means("the column sampled"));
+              .means("the column sampled (2D: the vertical line at x)"));
+    d.add(value<Probe>("y", member(&Probe::y))
+              .only_for(column)
+              .unit("m")
+              .note("**required** in 3D, not in 2D; within the container's y range")
+              .means("3D: the gauge is the vertical line at (x, y)"));
     d.add(value<Probe>("band", member(&Probe::band))
               .only_for(column)
               .unit("m")
               .range(Range::positive())
               .default_text("the largest `spacing`")
-              .means("half-width of the sampled column"));
+              .means("half-width of the sampled column (a square column in 3D)"));
     d.add(value<Probe>("datum", member(&Probe::datum))
               .only_for({"surface_elevation"})
               .unit("m")
-              .means("the elevation is measured from this y"));
+              .means("the elevation is measured from this height"));
     d.add(value<Probe>("origin", member(&Probe::origin))
               .only_for({"surge_front"})
               .unit("m")
@@ -220,12 +226,12 @@ const S<Output>& output_section() {
 const Section<Rect>& box_section() {
   static const S<Rect> s = [] {
     S<Rect> d;
-    d.add(value<Rect>("lo", member(&Rect::lo)).required().unit("m").means("lower-left corner"));
+    d.add(value<Rect>("lo", member(&Rect::lo)).required().unit("m").means("lowest corner"));
     d.add(value<Rect>("hi", member(&Rect::hi))
               .required()
               .unit("m")
-              .note("greater than `lo` in x and y")
-              .means("upper-right corner"));
+              .note("greater than `lo` on every axis")
+              .means("highest corner"));
     return d;
   }();
   return s;
@@ -242,7 +248,7 @@ const Section<Scene>& scene_section() {
     d.add(object<Scene>("container", member(&Scene::container), container_section).required().means("the tank"));
     d.add(array<Scene>("obstacles", member(&Scene::obstacles), box_section, "boxes")
               .note("each inside the container")
-              .means("solid rectangles (fluid outside)"));
+              .means("solid boxes (fluid outside)"));
     d.add(array<Scene>("fluid", member(&Scene::fluid), region_section, "regions")
               .required()
               .note("at least one")

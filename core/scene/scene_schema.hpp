@@ -79,31 +79,32 @@ struct Value<std::string> {
   static std::string show(const std::string& x) { return "`\"" + x + "\"`"; }
 };
 
-/// A point or vector: an array of D numbers. D is the scene's dimension; the reader is written for any D, so
-/// a 3D scene needs only a Vec<3> member and the dimension chosen from its container.
-template <int D>
-struct Value<Vec<D>> {
+/// A point or vector: an array of two numbers [x, y] in a 2D scene, three [x, y, z] in a 3D one. The reader
+/// takes either; that every vector has the scene's dimension (its container's) is the validator's rule, checked
+/// through for_each_vector. An empty AnyVec is a vector left at its default (zero): it is not written.
+template <>
+struct Value<AnyVec> {
   static constexpr KeyType type = KeyType::vector;
-  static std::string axes() { return D == 2 ? "[x, y]" : "[x, y, z]"; }
-  static Vec<D> read(const Json& v, const std::string& path) {
-    if (!v.is_array() || v.size() != static_cast<std::size_t>(D)) {
-      detail::fail(path, std::string("must be an array of ") + (D == 2 ? "two" : "three") + " numbers " + axes() +
-                             " (got " +
+  static std::string axes() { return "[x, y] or [x, y, z]"; }
+  static AnyVec read(const Json& v, const std::string& path) {
+    if (!v.is_array() || v.size() < 2 || v.size() > 3) {
+      detail::fail(path, "must be an array of two numbers [x, y] (2D) or three [x, y, z] (3D) (got " +
                              (v.is_array() ? "an array of " + std::to_string(v.size()) : std::string(type_name(v))) +
                              ")");
     }
-    Vec<D> x;
-    for (int k = 0; k < D; ++k) x[k] = read_number(v[k], detail::element(path, static_cast<std::size_t>(k)));
+    AnyVec x(static_cast<Eigen::Index>(v.size()));
+    for (std::size_t k = 0; k < v.size(); ++k) x[static_cast<Eigen::Index>(k)] = read_number(v[k], detail::element(path, k));
     return x;
   }
-  static Json write(const Vec<D>& x) {
+  static Json write(const AnyVec& x) {
     Json a = Json::array();
-    for (int k = 0; k < D; ++k) a.push_back(x[k]);
+    for (Eigen::Index k = 0; k < x.size(); ++k) a.push_back(x[k]);
     return a;
   }
-  static std::string show(const Vec<D>& x) {
+  static std::string show(const AnyVec& x) {
+    if (x.size() == 0) return "zero";
     std::string s = "[";
-    for (int k = 0; k < D; ++k) s += (k ? ", " : "") + detail::num(x[k]);
+    for (Eigen::Index k = 0; k < x.size(); ++k) s += (k ? ", " : "") + detail::num(x[k]);
     return s + "]";
   }
 };
@@ -128,6 +129,9 @@ struct is_optional<std::optional<V>> : std::true_type {};
 
 // ---- keys and sections ----------------------------------------------------------------------------------------
 
+/// Visits one vector of a scene with its key path (for_each_vector).
+using VectorVisitor = std::function<void(const std::string& path, const AnyVec& v)>;
+
 /// What one key does to a struct T: read its JSON value into T, write it out of T, check its range in T.
 template <class T>
 struct Binding {
@@ -135,6 +139,7 @@ struct Binding {
   std::function<void(const T&, Json&, const std::string&)> write;    // adds the key to the object if it is set
   std::function<std::optional<double>(const T&)> number;            // a number's or integer's value, if set
   std::function<void(const T&, const std::string&)> check;           // an object's or array's own keys
+  std::function<void(const T&, const std::string&, const VectorVisitor&)> vectors;  // the vectors it holds
 };
 
 template <class T>
@@ -226,6 +231,17 @@ void check_section(const Section<T>& s, const T& t, const std::string& path, std
   }
 }
 
+/// Visits every vector (AnyVec) the section's keys hold in t, set or defaulted, nested objects and arrays included.
+template <class T>
+void for_each_vector(const Section<T>& s, const T& t, const std::string& path, const VectorVisitor& visit,
+                     std::string variant = "") {
+  if (s.variant && !s.info.discriminator.empty()) variant = s.variant(t);
+  for (std::size_t i = 0; i < s.info.keys.size(); ++i) {
+    const KeyInfo& k = s.info.keys[i];
+    if (k.allowed_for(variant) && s.bindings[i].vectors) s.bindings[i].vectors(t, detail::join(path, k.name), visit);
+  }
+}
+
 // ---- the key builders -----------------------------------------------------------------------------------------
 
 /// A member reached by an accessor: `[](auto& f) -> auto& { return f.rect.lo; }`, or a pointer to member.
@@ -264,10 +280,22 @@ Key<T> value(const char* name, F access) {
       if (m) o[key] = Value<V>::write(*m);
     } else if constexpr (std::is_same_v<V, std::string>) {
       if (!m.empty()) o[key] = m;  // "" is what an absent string key reads as
+    } else if constexpr (std::is_same_v<V, AnyVec>) {
+      if (m.size() > 0) o[key] = Value<V>::write(m);  // empty is what an absent vector key reads as (zero)
     } else {
       o[key] = Value<V>::write(m);
     }
   };
+  if constexpr (std::is_same_v<V, AnyVec>) {
+    k.bind.vectors = [access](const T& t, const std::string& path, const VectorVisitor& visit) {
+      const M& m = access(t);
+      if constexpr (optional) {
+        if (m) visit(path, *m);
+      } else {
+        visit(path, m);
+      }
+    };
+  }
   if constexpr (std::is_arithmetic_v<V> && !std::is_same_v<V, bool>) {
     k.bind.number = [access](const T& t) -> std::optional<double> {
       const M& m = access(t);
@@ -316,6 +344,14 @@ Key<T> object(const char* name, F access, const Section<S>& (*section)(),
       check_section(section(), m, path, variant_of(t));
     }
   };
+  k.bind.vectors = [access, section, variant_of](const T& t, const std::string& path, const VectorVisitor& visit) {
+    const M& m = access(t);
+    if constexpr (optional) {
+      if (m) for_each_vector(section(), *m, path, visit, variant_of(t));
+    } else {
+      for_each_vector(section(), m, path, visit, variant_of(t));
+    }
+  };
   return k;
 }
 
@@ -347,6 +383,10 @@ Key<T> array(const char* name, F access, const Section<S>& (*section)(), const s
   k.bind.check = [access, section](const T& t, const std::string& path) {
     const auto& v = access(t);
     for (std::size_t i = 0; i < v.size(); ++i) check_section(section(), v[i], detail::element(path, i));
+  };
+  k.bind.vectors = [access, section](const T& t, const std::string& path, const VectorVisitor& visit) {
+    const auto& v = access(t);
+    for (std::size_t i = 0; i < v.size(); ++i) for_each_vector(section(), v[i], detail::element(path, i), visit);
   };
   return k;
 }

@@ -21,21 +21,29 @@ using detail::num;
 
 namespace {
 
+// Every box and point here has the scene's dimension (checked first by validate_scene), so the loops run over the
+// axes of whichever it is.
+
+/// "[1, 2]" or "[1, 2, 3]".
+std::string point(const AnyVec& p) {
+  std::string s = "[";
+  for (Eigen::Index a = 0; a < p.size(); ++a) s += (a ? ", " : "") + num(p[a]);
+  return s + "]";
+}
+
 void valid_rect(const Rect& r, const std::string& path) {
-  if (!(r.hi[0] > r.lo[0] && r.hi[1] > r.lo[1])) {
-    fail(join(path, "hi"), "must be greater than lo in x and in y (lo = [" + num(r.lo[0]) + ", " + num(r.lo[1]) +
-                               "], hi = [" + num(r.hi[0]) + ", " + num(r.hi[1]) + "])");
+  if (!(r.hi.array() > r.lo.array()).all()) {
+    fail(join(path, "hi"), "must be greater than lo on every axis (lo = " + point(r.lo) + ", hi = " + point(r.hi) + ")");
   }
 }
 
-bool rects_overlap(const Rect& a, const Rect& b) {
-  return a.lo[0] < b.hi[0] && b.lo[0] < a.hi[0] && a.lo[1] < b.hi[1] && b.lo[1] < a.hi[1];
+/// Whether the open boxes a and b, each shrunk by t, share a point.
+bool rects_overlap(const Rect& a, const Rect& b, double t = 0.0) {
+  return (a.lo.array() < b.hi.array() - t).all() && (b.lo.array() < a.hi.array() - t).all();
 }
 
-double distance_to_rect(const Vec<2>& p, const Rect& r) {
-  const double dx = std::max({r.lo[0] - p[0], 0.0, p[0] - r.hi[0]});
-  const double dy = std::max({r.lo[1] - p[1], 0.0, p[1] - r.hi[1]});
-  return std::hypot(dx, dy);
+double distance_to_rect(const AnyVec& p, const Rect& r) {
+  return (r.lo - p).cwiseMax(p - r.hi).cwiseMax(0.0).norm();
 }
 
 constexpr double kTol = 1e-9;
@@ -43,16 +51,27 @@ constexpr double kMaxParticles = 5.0e7;
 
 bool inside(const Rect& inner, const Rect& outer) {
   const double t = kTol * std::max(1.0, (outer.hi - outer.lo).cwiseAbs().maxCoeff());
-  return inner.lo[0] >= outer.lo[0] - t && inner.lo[1] >= outer.lo[1] - t && inner.hi[0] <= outer.hi[0] + t &&
-         inner.hi[1] <= outer.hi[1] + t;
+  return (inner.lo.array() >= outer.lo.array() - t).all() && (inner.hi.array() <= outer.hi.array() + t).all();
 }
 
 Rect bounds(const FluidRegion& f) {
   if (f.shape == Shape::rectangle) return f.rect;
-  return Rect{f.centre - Vec<2>::Constant(f.radius), f.centre + Vec<2>::Constant(f.radius)};
+  const AnyVec r = AnyVec::Base::Constant(f.centre.size(), f.radius);
+  return Rect{f.centre - r, f.centre + r};
 }
 
-std::string point(const Vec<2>& p) { return "[" + num(p[0]) + ", " + num(p[1]) + "]"; }
+/// Every vector of the scene has the container's dimension (an empty one is a zero default). The container's
+/// lo fixes it, and is read first.
+void check_dimension(const Scene& s) {
+  const Eigen::Index dim = s.container.box.lo.size();
+  const std::string axes = dim == 3 ? "three numbers [x, y, z]" : "two numbers [x, y]";
+  schema::for_each_vector(schema::scene_section(), s, "", [&](const std::string& path, const AnyVec& v) {
+    if (v.size() != 0 && v.size() != dim) {
+      fail(path, "has " + std::to_string(v.size()) + " numbers, but the scene is " + std::to_string(dim) +
+                     "D (container.lo has " + std::to_string(dim) + "): write " + axes);
+    }
+  });
+}
 
 /// A region as the scene gives it, for messages: "rectangle [0, 0] .. [1, 2]", "circle at [8, 7] radius 1".
 std::string describe(const FluidRegion& f) {
@@ -66,8 +85,7 @@ std::string describe(const FluidRegion& f) {
 /// circle, so both can hold the point of contact. `t` absorbs rounding in coordinates given as decimals.
 bool regions_overlap(const FluidRegion& a, const FluidRegion& b, double t) {
   if (a.shape == Shape::rectangle && b.shape == Shape::rectangle) {
-    return a.rect.lo[0] < b.rect.hi[0] - t && b.rect.lo[0] < a.rect.hi[0] - t && a.rect.lo[1] < b.rect.hi[1] - t &&
-           b.rect.lo[1] < a.rect.hi[1] - t;
+    return rects_overlap(a.rect, b.rect, t);
   }
   if (a.shape == Shape::circle && b.shape == Shape::circle) return (a.centre - b.centre).norm() < a.radius + b.radius + t;
   const FluidRegion& circle = a.shape == Shape::circle ? a : b;
@@ -96,8 +114,11 @@ void validate_region(const Scene& s, const FluidRegion& f, const std::string& pa
   }
   if (f.hydrostatic) {
     if (!s.effects.gravity) fail(join(path, "hydrostatic"), "needs effects.gravity");
-    if ((*s.effects.gravity)[0] != 0.0 || !((*s.effects.gravity)[1] < 0.0)) {
-      fail(join(path, "hydrostatic"), "needs gravity pointing along -y ([0, -g])");
+    const AnyVec& g = *s.effects.gravity;
+    const Eigen::Index up = g.size() - 1;
+    if (!g.head(up).isZero(0.0) || !(g[up] < 0.0)) {
+      fail(join(path, "hydrostatic"), up == 2 ? "needs gravity pointing along -z ([0, 0, -g])"
+                                              : "needs gravity pointing along -y ([0, -g])");
     }
     if (f.shape == Shape::circle && !f.surface) fail(join(path, "surface"), "required for a hydrostatic circle");
   } else if (f.surface) {
@@ -109,6 +130,12 @@ void validate_probe(const Scene& s, const Probe& p, const std::string& path) {
   const Rect& c = s.container.box;
   if (p.kind == ProbeKind::water_height || p.kind == ProbeKind::surface_elevation) {
     if (p.x < c.lo[0] - kTol || p.x > c.hi[0] + kTol) fail(join(path, "x"), "must lie within the container's x range");
+    if (dimension(s) == 3) {
+      if (!p.y) fail(join(path, "y"), "missing required key in a 3D scene (the gauge is the vertical line at (x, y))");
+      if (*p.y < c.lo[1] - kTol || *p.y > c.hi[1] + kTol) fail(join(path, "y"), "must lie within the container's y range");
+    } else if (p.y) {
+      fail(join(path, "y"), "only in a 3D scene (a 2D gauge is the vertical line at x)");
+    }
   }
   if (p.kind == ProbeKind::pressure && !inside(Rect{p.position, p.position}, c)) {
     fail(join(path, "position"), "must lie inside the container");
@@ -125,6 +152,7 @@ void validate_probe(const Scene& s, const Probe& p, const std::string& path) {
 
 void validate_scene(const Scene& s) {
   schema::check_section(schema::scene_section(), s, "");
+  check_dimension(s);
   if (s.name.empty()) fail("name", "must not be empty");
   for (char ch : s.name) {
     if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-' || ch == '.')) {
