@@ -49,7 +49,7 @@ class ParticleStore {
   Field<VecD> v{"velocity", "m/s"};
   Field<double> rho{"density", "kg/m^3"};
   Field<double> p{"pressure", "Pa"};
-  Field<double> m{"mass", "kg/m"};  // 2D: per metre of depth (rho0 d^2), as energies are J/m
+  Field<double> m{"mass", D == 2 ? "kg/m" : "kg"};  // 2D: per metre of depth (rho0 d^2), as energies are J/m
   Field<double> h{"smoothing_length", "m"};
   Field<double> d{"spacing", "m"};
   Field<std::int32_t> level{"level", "1"};

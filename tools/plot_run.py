@@ -21,9 +21,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
 
-BASE = ["time", "step", "dt", "fluid", "ghosts", "walls", "mass", "removed", "removed_mass", "momentum_x", "momentum_y",
-        "momentum_z", "angular_momentum", "angular_momentum_x", "angular_momentum_y", "angular_momentum_z", "kinetic",
-        "potential", "elastic", "total_energy", "max_speed", "max_density_error"]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from read_output import DIAGNOSTICS  # noqa: E402
+
+BASE = DIAGNOSTICS
 
 # particles.png: the figure's bounds (inches), the room a panel needs beside its drawing (tick labels, title) and
 # the colour bar's width.

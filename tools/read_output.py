@@ -27,6 +27,11 @@ import h5py
 import numpy as np
 
 KIND_NAMES = {0: "fluid", 1: "wall", 2: "ghost"}
+# The time series' columns that are not probes or level counts, in a 2D or a 3D run (docs/SCENES.md, "The output
+# folder"); tools/plot_run.py uses the same list.
+DIAGNOSTICS = ["time", "step", "dt", "fluid", "ghosts", "walls", "mass", "removed", "removed_mass", "momentum_x",
+               "momentum_y", "momentum_z", "angular_momentum", "angular_momentum_x", "angular_momentum_y",
+               "angular_momentum_z", "kinetic", "potential", "elastic", "total_energy", "max_speed", "max_density_error"]
 
 
 def load_series(folder):
@@ -135,10 +140,7 @@ def summarize(folder, frame_index=-1):
         s["max_density_error"] = float(np.max(series["max_density_error"]))
         levels = sorted(k for k in series if k.startswith("level_"))
         s["final_per_level"] = {k: int(series[k][-1]) for k in levels}
-        known = {"time", "step", "dt", "fluid", "ghosts", "walls", "mass", "removed", "removed_mass", "momentum_x",
-                 "momentum_y",
-                 "angular_momentum", "kinetic", "potential", "elastic", "total_energy", "max_speed",
-                 "max_density_error"} | set(levels)
+        known = set(DIAGNOSTICS) | set(levels)
         s["probes"] = {k: {"first": float(v[0]), "last": float(v[-1]), "min": float(np.nanmin(v)),
                            "max": float(np.nanmax(v))} for k, v in series.items() if k not in known}
     files = frame_files(folder)

@@ -1,10 +1,10 @@
 #!/usr/bin/python3
-"""ctest check of tools/plot_run.py's particles.png: run sphrefine on a tall and on a wide, shallow tiny scene,
+"""ctest check of tools/plot_run.py's particles.png: run sphrefine on a tall, a wide and shallow, and a 3D tiny scene,
 plot each, and look at the figures as matplotlib saved them.
 
     /usr/bin/python3 tools/test_plot_run.py PATH/TO/sphrefine
 
-For either aspect: four panels, each showing the whole container (its top included, not only where the fluid
+For either aspect, and for a 3D scene seen from the side (x across, z up): four panels, each showing the whole container (its top included, not only where the fluid
 is) at equal scales, a figure within sensible bounds, and panels that fill a fair part of it (not small strips
 in a wide empty figure). Exit status 0 on success, 1 on failure.
 """
@@ -38,8 +38,20 @@ def scene(name, hi, fluid_hi):
     }
 
 
-# A column in a tall tank (1 m x 2 m), and a wide, shallow layer (4 m x 0.5 m, water 0.2 m deep).
-SCENES = {"tall": scene("tall", [1, 2], [0.5, 0.5]), "wide": scene("wide", [4, 0.5], [4, 0.2])}
+def scene_3d(name, hi, fluid_hi):
+    """The same in 3D: up is z, and the figure shows the side view (x, z)."""
+    s = scene(name, hi, fluid_hi)
+    s["container"]["lo"] = [0, 0, 0]
+    s["fluid"][0]["lo"] = [0, 0, 0]
+    s["material"]["reference_height"] = fluid_hi[2]
+    s["effects"]["gravity"] = [0, 0, -9.81]
+    return s
+
+
+# A column in a tall tank (1 m x 2 m), a wide, shallow layer (4 m x 0.5 m, water 0.2 m deep), and a 3D column in
+# a tank 1 m long, 0.3 m wide and 0.8 m high, seen from the side.
+SCENES = {"tall": scene("tall", [1, 2], [0.5, 0.5]), "wide": scene("wide", [4, 0.5], [4, 0.2]),
+          "tank_3d": scene_3d("tank_3d", [1, 0.3, 0.8], [0.5, 0.3, 0.4])}
 
 # Bounds of a readable figure (inches) and the least fraction of it the four panels' drawings should cover: the
 # layout that suits the aspect gives 0.52 (wide) and 0.70 (tall) here; a row of four small panels across a
@@ -92,7 +104,7 @@ def main():
             check(fig is not None, f"{name}: particles.png saved through matplotlib")
             if fig is None:
                 continue
-            (x0, y0), (x1, y1) = sc["container"]["lo"], sc["container"]["hi"]
+            (x0, y0), (x1, y1) = plot_run.plane(sc["container"]["lo"]), plot_run.plane(sc["container"]["hi"])
             check(len(fig["panels"]) == 4, f"{name}: {len(fig['panels'])} panels")
             for k, p in enumerate(fig["panels"]):
                 check(p["xlim"][0] <= x0 and p["xlim"][1] >= x1, f"{name} panel {k}: x range {p['xlim']} misses the container")
