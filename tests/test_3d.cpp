@@ -2,42 +2,28 @@
 // bitwise the same at 1 and 2 threads, frames are N x 3 with an XYZ XDMF, a checkpoint resumes bitwise and refuses
 // the other dimension, and the probes measure in 3D.
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstddef>
 #include <limits>
 #include <vector>
 
-#include "tests/support/thread_count.hpp"
-#include "core/boundary/ghosts.hpp"
-#include "core/boundary/wall.hpp"
-#include "core/boundary/wall_particles.hpp"
 #include "core/case_builder.hpp"
 #include "core/io/hdf5_frames.hpp"
 #include "core/io/xdmf.hpp"
-#include "core/refinement/family.hpp"
 #include "core/scene/probes.hpp"
-#include "core/refinement/merge_pass.hpp"
-#include "core/refinement/patterns.hpp"
-#include "core/refinement/refinement_stage.hpp"
-#include "core/refinement/split_pass.hpp"
-#include "core/setup.hpp"
 #include "tests/support/io_helpers.hpp"
 #include "tests/support/physics_helpers.hpp"
 #include "tests/support/test_scale.hpp"
+#include "tests/support/thread_count.hpp"
 
 namespace {
 
 using sph::Kind;
-using sph::Vec;
-using Vec3 = Vec<3>;
-
-constexpr double kG = 9.81;
-
 using sph::test::ThreadCount;
+using Vec3 = sph::Vec<3>;
 
+constexpr double kG = 9.81;  // the cases' gravity (m/s^2)
 
 // ---------------------------------------------------------------------------------------------------
 // The driver in 3D

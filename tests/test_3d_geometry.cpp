@@ -1,41 +1,22 @@
 // Three dimensions (issue #18), the geometry: the walls of a box container, and ghosts in its corners, on its edges
 // and on its faces, with the hydrostatic ghost pressure.
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <algorithm>
-#include <cmath>
-#include <cstddef>
-#include <limits>
 #include <vector>
 
-#include "tests/support/thread_count.hpp"
 #include "core/boundary/ghosts.hpp"
 #include "core/boundary/wall.hpp"
-#include "core/boundary/wall_particles.hpp"
-#include "core/case_builder.hpp"
-#include "core/io/hdf5_frames.hpp"
-#include "core/io/xdmf.hpp"
-#include "core/refinement/family.hpp"
-#include "core/scene/probes.hpp"
-#include "core/refinement/merge_pass.hpp"
-#include "core/refinement/patterns.hpp"
-#include "core/refinement/refinement_stage.hpp"
-#include "core/refinement/split_pass.hpp"
-#include "core/setup.hpp"
-#include "tests/support/io_helpers.hpp"
+#include "core/equation_of_state.hpp"
+#include "core/particle_store.hpp"
 #include "tests/support/physics_helpers.hpp"
-#include "tests/support/test_scale.hpp"
 
 namespace {
 
 using sph::Kind;
-using sph::Vec;
-using Vec3 = Vec<3>;
+using Vec3 = sph::Vec<3>;
 
-constexpr double kG = 9.81;
-
-using sph::test::ThreadCount;
+constexpr double kG = 9.81;  // the ghost pressure's gravity (m/s^2)
 
 sph::Geometry3 unit_box(bool open_top) {
   sph::Geometry3 g;
