@@ -95,6 +95,17 @@ class PairSweep {
           const double hi = s.h[i];
           const double inv_hi = 1.0 / hi;
           pr.p_rho2_i = s.p[i] / (s.rho[i] * s.rho[i]);
+          // Wall particles act only within the wall effects' reach (Lennard-Jones: r0 = r0_factor d_i, well inside
+          // the support h_i), so those beyond it are skipped before the pair's geometry is computed. The bound is
+          // widened by a relative 1e-12 so that every pair the effect's own test (r < r0) keeps passes it: the
+          // results do not change, only the work.
+          double wall_reach2 = 0.0;
+          if constexpr (has_wall_effects) {
+            double reach = 0.0;
+            std::apply([&](const auto&... eff) { ((reach = std::max(reach, eff.reach(s, i))), ...); }, wall_);
+            reach *= 1.0 + 1e-12;
+            wall_reach2 = reach * reach;
+          }
           // A particle that is not due only meets due ones: it skips a layer (a level) or a run without any.
           const bool all = due || act.due_prefix == nullptr;
           const auto holds_due = [&](std::uint32_t b, std::uint32_t e) { return all || act.due_prefix[e] != act.due_prefix[b]; };
@@ -106,6 +117,7 @@ class PairSweep {
               const double r2 = xij.squaredNorm();
               const double support = hi + s.h[j];
               if (r2 >= support * support || j == i) continue;
+              if (s.kind[j] == Kind::wall && !(due && r2 < wall_reach2)) continue;
               pr.j = j;
               pr.xij = xij;
               pr.r2 = r2;
@@ -113,13 +125,11 @@ class PairSweep {
               pr.hij = 0.5 * support;
               pr.vij = vi - s.v[j];
               pr.vx = pr.vij.dot(xij);
-              if (s.kind[j] == Kind::wall) {
-                pairs += due ? 1 : 0;
+              if (s.kind[j] == Kind::wall) {  // due, and within the wall effects' reach
+                ++pairs;
                 if constexpr (has_wall_effects) {
-                  if (due) {
-                    pr.weight = kBinWeight[static_cast<std::size_t>(bi)];
-                    std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, wall_);
-                  }
+                  pr.weight = kBinWeight[static_cast<std::size_t>(bi)];
+                  std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, wall_);
                 }
                 continue;
               }

@@ -9,6 +9,12 @@ struct LennardJonesWall {
   double strength = 1.0;   // D, m^2/s^2
   double r0_factor = 0.5;  // r0 = r0_factor * d_i
 
+  /// The farthest a wall particle acts on fluid particle i: r0. The sweep skips wall particles beyond it.
+  template <int D>
+  double reach(const ParticleView<D>& s, std::size_t i) const {
+    return r0_factor * s.d[i];
+  }
+
   template <int D>
   void operator()(const ParticleView<D>& s, const Pair<D>& pr, PairSums<D>& acc) const {
     const double r0 = r0_factor * s.d[pr.i];

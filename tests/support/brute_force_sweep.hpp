@@ -63,12 +63,12 @@ ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<
       const Vec<D> xij = s.x[i] - s.x[j];
       const double r = xij.norm();
       if (!(r < s.h[i] + s.h[j])) continue;
-      if (s.kind[j] == Kind::wall) {  // eq. (10), r0 = r0_factor d_i
-        if (!due) continue;
-        ++ref.pairs;
-        if (!st.lennard_jones) continue;
+      if (s.kind[j] == Kind::wall) {  // eq. (10), r0 = r0_factor d_i: a wall pair is one within r0
+        if (!due || !st.lennard_jones) continue;
         const double r0 = st.lennard_jones->r0_factor * s.d[i];
-        if (r >= r0 || r == 0.0) continue;
+        if (r >= r0) continue;
+        ++ref.pairs;
+        if (r == 0.0) continue;
         const Vec<D> f = wi * st.lennard_jones->strength * (std::pow(r0 / r, 12) - std::pow(r0 / r, 6)) * xij / (r * r);
         ai += f;
         scale += f.norm();
