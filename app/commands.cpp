@@ -262,6 +262,11 @@ int run_command(const RunArguments& args) {
       std::fprintf(stderr, "error: --resume: %s is not a sphrefine checkpoint (%s)\n", args.resume.c_str(), why.c_str());
       return kExitUsage;
     }
+    if (const int dim = io::checkpoint_dimension(args.resume); dim != scene::dimension(s)) {
+      std::fprintf(stderr, "error: --resume: %s holds a %dD run, but the scene is %dD\n", args.resume.c_str(), dim,
+                   scene::dimension(s));
+      return kExitUsage;
+    }
     if (args.force) {
       std::fprintf(stderr, "error: --resume continues the run in its folder; --force would erase it\n");
       return kExitUsage;

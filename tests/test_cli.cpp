@@ -329,6 +329,28 @@ TEST_F(Cli, CheckpointAndResumeThroughTheProgram) {
   EXPECT_EQ(other.err.rfind("scene error: --resume: the checkpoint was written by a different scene", 0), 0u) << other.err;
 }
 
+TEST_F(Cli, A3DSceneRunsAndResumesOnlyInto3D) {
+  // The same program runs a 3D scene (the container's corners have three coordinates) and says so; a checkpoint
+  // of one dimension does not resume a scene of the other.
+  write_scene("tiny.json", kTiny);
+  write_scene("tank3.json", R"({
+    "container": { "lo": [0, 0, 0], "hi": [0.3, 0.2, 0.4] },
+    "fluid": [ { "shape": "rectangle", "lo": [0, 0, 0], "hi": [0.3, 0.2, 0.2], "spacing": 0.05, "hydrostatic": true } ],
+    "material": { "rho0": 1000, "mach_factor": 10, "reference_height": 0.2 },
+    "effects": { "gravity": [0, 0, -9.81], "ghost_walls": "free-slip" },
+    "time": { "end": 0.01 }
+  })");
+  const Result validated = run("validate tank3.json");
+  EXPECT_EQ(validated.code, 0) << validated.err;
+  EXPECT_NE(validated.out.find("scene OK: tank3 (3D)"), std::string::npos) << validated.out;
+  const Result ran = run("run tank3.json -o t3 --checkpoint-every 0.005");
+  ASSERT_EQ(ran.code, 0) << ran.err;
+  EXPECT_NE(ran.out.find("tank3 (3D), 96 fluid particles"), std::string::npos) << ran.out;
+  const Result crossed = run("run tiny.json -o t3 --resume t3/checkpoint.h5");
+  EXPECT_EQ(crossed.code, 2);
+  EXPECT_EQ(crossed.err, "error: --resume: t3/checkpoint.h5 holds a 3D run, but the scene is 2D\n");
+}
+
 TEST_F(Cli, ASceneTooBigForMemoryIsRefusedBeforeAnythingIsAllocated) {
   // 48 million lattice points (under the 5e7 cap), quadrupled by a static refinement pass, in a sheet six
   // refined rows thick on the floor of a 12 km tank: with h_factor 3 every particle has a ghost below the
