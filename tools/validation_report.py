@@ -671,6 +671,21 @@ def findings_section(f):
                    + f", measured {lob['peak_H2']:.2f}) are the plunging jet passing over it, which the "
                    "measured record does not show. The runs end at t* = 8, where the measured "
                    "levels keep changing, so the RMS columns of H2-H4 cover only that part of the record.")
+        by_name = {r["name"]: r for r in lob["rows"]}
+        two, three = by_name.get("unrefined"), by_name.get("3d_refined")
+        if two and three:
+            def pair(key, fmt):
+                return f"{format(three[key], fmt)} (2D {format(two[key], fmt)})"
+            gauges = ", ".join(f"{g} {pair('rms_' + g, '.3f')}" for g in ("H1", "H2", "H3", "H4"))
+            out.append("- Lobovsky in 2D and in the experiment's 3D tank at the same spacing d = H/30 (`3d_refined` against "
+                       f"`unrefined`): RMS h/H {gauges}; the wave reflected at H4 peaks at {pair('peak_H4', '.2f')} "
+                       f"(measured {lob['peak_H4']:.2f}); sensor 1's impact peak {pair('p1_peak', '.2f')} and impulse "
+                       f"{pair('p1_impulse', '.3f')} (measured {lob['impact'][0]:.2f} and {lob['impact'][2]:.3f}); the "
+                       f"quasi-static p* at sensor 1 {pair('p1_late', '.2f')} (measured {lob['p_exp']:.2f}). Why the 3D "
+                       "runs differ from the 2D one is not measured here. Candidates: what the width lets the water do "
+                       "(the plunging jet and its cavity are no longer infinitely long), the Lennard-Jones particles of "
+                       "the two side walls 15 spacings apart, and the 3D kernel gradient's larger normalisation error "
+                       "(docs/METHOD.md, the still tank).")
     out.append("")
     return "\n".join(out)
 
@@ -699,7 +714,7 @@ def runtime_text(lanes, report_seconds):
     if miss_full:
         text += f" ({miss_full} run{'s' if miss_full > 1 else ''} without a stored timing not counted: a run the watchdog stops stores none)"
     text += (f". The quick form (`scripts/validate --quick`: no 16x runs, no a/120 or no-slip column, no coarsening "
-             f"at 4x, no RSP for Lobovsky, the reference at 4x, each run once) runs {len(build_jobs(True))}: about {quick / lanes / 60:.0f} minutes on {lanes} cores by the "
+             f"at 4x, no RSP for Lobovsky and only its unrefined 3D run, the reference at 4x, each run once) runs {len(build_jobs(True))}: about {quick / lanes / 60:.0f} minutes on {lanes} cores by the "
              "same timings")
     if miss_quick:
         text += f" ({miss_quick} without a stored timing, not counted)"
@@ -745,6 +760,16 @@ def build_jobs(quick):
     jobs.append(("lobovsky", lob, "aap", [f"effects.refinement={refinement('aap', lob_thr)}"] + lob_rows, 2))
     if not quick:
         jobs.append(("lobovsky", lob, "rsp", [f"effects.refinement={refinement('rsp', lob_thr)}"] + lob_rows, 2))
+    # The same in the experiment's 3D tank (cases/validation/lobovsky_3d.json), from d = H/15 (3,375 particles):
+    # unrefined, fully refined to H/30 (27,000: the 2D runs' spacing; a cube of eight daughters of the H/15 lattice
+    # is the H/30 lattice) and AAP between them. The fully refined and the AAP runs take about 40 and 14 minutes on
+    # one thread, so the quick form leaves them out.
+    lob3 = "cases/validation/lobovsky_3d.json"
+    lob3_base = ["fluid.0.spacing=0.02"] + lob_rows
+    jobs.append(("lobovsky", lob3, "3d_unrefined", lob3_base, 1))
+    if not quick:
+        jobs.append(("lobovsky", lob3, "3d_aap", [f"effects.refinement={refinement('aap', lob_thr)}"] + lob3_base, 4))
+        jobs.append(("lobovsky", lob3, "3d_refined", [f"effects.static_refinement={STATIC}"] + lob3_base, 8))
 
     # The still tank (cases/still_tank.json, 10 s) at two spacings, rows every 10 ms (its compression mode rings at
     # 2.6 Hz): the time-averaged pressure per depth and the oscillation's amplitude.
@@ -1190,7 +1215,11 @@ def main():
         md.append("![levels](figures/validation_lobovsky.png)\n\n![sensor 1](figures/validation_lobovsky_p1.png)\n")
         md.append("Variants: uniform runs at d = H/30 (`unrefined`), H/(30 sqrt 2) (`unrefined_x2`) and H/60 "
                   "(`refined`), and the dynamic runs `aap` and `rsp` (d = H/30 refined to H/60 where the speed "
-                  "passes the dam break's threshold at the same Froude number). Rows every 0.5 ms (t* = 0.003).\n")
+                  "passes the dam break's threshold at the same Froude number). Rows every 0.5 ms (t* = 0.003). "
+                  "The `3d_` runs are in the experiment's tank, 0.15 m wide, with free-slip side walls, the gauges and "
+                  "sensors on its centre line: `3d_unrefined` at d = H/15, `3d_refined` refined once everywhere to "
+                  "H/30 (the 2D `unrefined` spacing, eight times the particles), `3d_aap` refined from H/15 to H/30 "
+                  "where the speed passes the same threshold. Each runs on one thread like the 2D ones.\n")
         md.append(table(rows, [("variant", lambda r: r["name"]), ("wall s", lambda r: r["wall"])] +
                         [(f"RMS h/H {g}", (lambda g: lambda r: r[f"rms_{g}"])(g)) for g in cols] +
                         [("H4 peak h/H, 6 <= t* <= 8", lambda r: r["peak_H4"]),
