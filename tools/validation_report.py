@@ -760,8 +760,8 @@ def build_jobs(quick):
     jobs.append(("lobovsky", lob, "aap", [f"effects.refinement={refinement('aap', lob_thr)}"] + lob_rows, 2))
     if not quick:
         jobs.append(("lobovsky", lob, "rsp", [f"effects.refinement={refinement('rsp', lob_thr)}"] + lob_rows, 2))
-    # The same in the experiment's 3D tank (cases/validation/lobovsky_3d.json), from d = H/15 (3,375 particles):
-    # unrefined, fully refined to H/30 (27,000: the 2D runs' spacing; a cube of eight daughters of the H/15 lattice
+    # The same in the experiment's 3D tank (cases/validation/lobovsky_3d.json), from d = H/15 (3,150 particles):
+    # unrefined, fully refined to H/30 (25,200: the 2D runs' spacing; a cube of eight daughters of the H/15 lattice
     # is the H/30 lattice) and AAP between them. The fully refined and the AAP runs take about 40 and 14 minutes on
     # one thread, so the quick form leaves them out.
     lob3 = "cases/validation/lobovsky_3d.json"
