@@ -1,5 +1,5 @@
 // Case regressions: every case of cases/ and cases/validation/ runs to a fraction of its end time (a quarter;
-// a twentieth under the sanitizer preset, or less where that would exceed the work budget below) through the same
+// a fiftieth under the sanitizer preset, or less where that would exceed the work budget below) through the same
 // Runner as the program, conserves mass exactly, and
 // its probes stay within a tolerance of the reference series of a full-length run stored in
 // tests/data/case_references/ (tools/case_references.py writes them). Each row is compared with the reference
@@ -97,12 +97,12 @@ double fluid_height(const scene::Scene& s) {
 // first step's dt, a 3D particle-step counted as four). A quarter of every 2D case is within it (the largest, the
 // fully refined dam break, about 8e6); a 3D case runs to where its budget ends instead (the 3D dam break to about
 // 2 % of its end time, Lobovsky's tank to 0.6 %), so that the suite stays within CI's time: it still checks the
-// start of the flow. Under the sanitizer preset the budget shrinks with the fraction (0.05 / 0.25).
+// start of the flow. Under the sanitizer preset the budget shrinks with the fraction (0.02 / 0.25).
 constexpr double kWorkBudget = 1.0e7;
 
 /// The end time of a case's short run: the fraction of its end, cut to the work budget.
 double short_end(const scene::Scene& s) {
-  const double fraction = test::short_runs() ? 0.05 : 0.25;
+  const double fraction = test::short_runs() ? 0.02 : 0.25;
   const auto [fluid, dt] = scene::with_dimension(s, [&](auto dim) {
     const auto sim = scene::build_simulation<decltype(dim)::value>(s);
     return std::pair<double, double>(static_cast<double>(sim.diagnostics().fluid), sim.dt());

@@ -50,11 +50,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   if (!(estimated_particles(s) <= kMaxRunParticles)) return 0;
   try {
-    Simulation sim = build_simulation(s);
-    for (int k = 0; k < kSteps && sim.time() < s.time.end; ++k) {
-      sim.step(s.time.end - sim.time());
-      sim.run_stages();
-    }
+    with_dimension(s, [&](auto dim) {
+      auto sim = build_simulation<decltype(dim)::value>(s);
+      for (int k = 0; k < kSteps && sim.time() < s.time.end; ++k) {
+        sim.step(s.time.end - sim.time());
+        sim.run_stages();
+      }
+    });
   } catch (const SimulationFailure&) {
     return 0;  // the watchdog stopped an odd scene: a clear, valid outcome
   } catch (const std::exception& e) {
