@@ -4,8 +4,6 @@
 // program passes what the machine has).
 #include <gtest/gtest.h>
 
-#include <array>
-
 #include <filesystem>
 #include <regex>
 #include <string>
@@ -30,13 +28,13 @@ TEST(SceneMemory, ParticleEstimatesBoundWhatEveryCaseBuilds) {
     if (entry.path().extension() != ".json") continue;
     SCOPED_TRACE(entry.path().string());
     const Scene s = load_scene(entry.path());
-    const auto [fluid, ghosts, walls] = with_dimension(s, [&](auto dim) {
-      const auto d = build_simulation<decltype(dim)::value>(s).diagnostics();
-      return std::array<std::size_t, 3>{d.fluid, d.ghosts, d.walls};
-    });
-    const struct {
+    struct Counts {
       std::size_t fluid, ghosts, walls;
-    } d{fluid, ghosts, walls};
+    };
+    const Counts d = with_dimension(s, [&](auto dim) {
+      const auto diag = build_simulation<decltype(dim)::value>(s).diagnostics();
+      return Counts{diag.fluid, diag.ghosts, diag.walls};
+    });
     EXPECT_LE(static_cast<double>(d.fluid), estimated_fluid_particles(s));
     EXPECT_GE(static_cast<double>(d.fluid), 0.7 * estimated_fluid_particles(s)) << "the circles' estimate is an upper one";
     EXPECT_LE(static_cast<double>(d.ghosts), estimated_ghost_particles(s));

@@ -58,10 +58,6 @@ double column_top(const ParticleStore<D>& store, const Horizontal<D>& at, double
   return layered_top(v, gap, 2.0 * gap);
 }
 
-double column_top(const ParticleStore<2>& store, double x, double band, double gap) {
-  return column_top<2>(store, Horizontal<2>::Constant(x), band, gap);
-}
-
 }  // namespace
 
 template <int D>

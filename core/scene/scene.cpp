@@ -97,10 +97,6 @@ double sum_over_walls(const Scene& s, F per_axis) {
 
 }  // namespace
 
-double wall_size(const Scene& s) {
-  return sum_over_walls(s, [](double extent) { return extent; });
-}
-
 double estimated_wall_particles(const Scene& s) {
   if (!s.effects.lennard_jones_wall) return 0.0;
   // On each face, one particle every wall spacing from edge to edge: ceil(extent / spacing) + 1 of them along

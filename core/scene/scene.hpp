@@ -191,9 +191,6 @@ double estimated_fluid_particles(const Scene& s);
 double estimated_wall_particles(const Scene& s);
 /// An upper bound on the ghost particles at the start (0 without ghost walls), from the walls' lengths.
 double estimated_ghost_particles(const Scene& s);
-/// The total size of the walls: their length in 2D (m), their area in 3D (m^2). The container's bottom and sides
-/// (and top when closed), every obstacle's faces.
-double wall_size(const Scene& s);
 
 /// What a run of the scene holds in memory at its start: particles (fluid, ghosts, walls) and bytes.
 struct MemoryEstimate {
