@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "core/case_builder.hpp"
+#include "core/kernel.hpp"
 #include "core/io/hdf5_frames.hpp"
 #include "core/io/xdmf.hpp"
 #include "core/scene/probes.hpp"
@@ -55,10 +57,39 @@ struct LayerAverage {
   double ratio() const { return sum / time; }
 };
 
-TEST(StillTank3D, StaysStillAndHydrostatic) {
+/// The cubic spline's gradient normalisation on the cubic lattice of spacing 1 at h = h_factor:
+/// N = -sum_j V_j z_ij dW/dz (V_j = 1). A hydrostatic column needs its pressure gradient 1/N times rho g to stand
+/// still (docs/METHOD.md, "The unrefined tank's own pressure offset").
+double lattice_normalisation(double h_factor) {
+  double n = 0.0;
+  for (int a = -3; a <= 3; ++a)
+    for (int b = -3; b <= 3; ++b)
+      for (int c = -3; c <= 3; ++c) {
+        const Vec3 xij(a, b, c);  // x_i - x_j, j a lattice neighbour of i
+        const double r = xij.norm();
+        if (r == 0.0) continue;
+        n -= xij[2] * xij[2] * sph::CubicSpline<3>::gradient_factor(r, h_factor);
+      }
+  return n;
+}
+
+/// The 3D still tank at two sets of settings: the paper's (h = 1.2 d, c0 = 10 sqrt(2 g H_ref)) and the peer's 3D
+/// ones (DualSPHysics' CaseDambreak: h = sqrt(3) d, coefsound 20).
+struct TankSettings {
+  const char* name;
+  double h_factor;
+  double mach_factor;
+};
+
+class StillTank3D : public testing::TestWithParam<TankSettings> {};
+
+TEST_P(StillTank3D, StaysStillAndHydrostatic) {
   // 1 x 0.4 m, 0.5 m deep, d = 0.05 m: 1600 particles. Under the sanitizer preset (SPH_TEST_SCALE=short), which
   // looks for memory and undefined-behaviour errors, a 0.4 x 0.2 m tank 0.3 m deep (192 particles).
+  const TankSettings& settings = GetParam();
   sph::Tank3Spec spec;
+  spec.h_factor = settings.h_factor;
+  spec.mach_factor = settings.mach_factor;
   if (sph::test::short_runs()) {
     spec.length = 0.4;
     spec.width = 0.2;
@@ -70,8 +101,8 @@ TEST(StillTank3D, StaysStillAndHydrostatic) {
   ASSERT_EQ(d0.fluid, sph::test::short_runs() ? 192u : 1600u);
   EXPECT_GT(d0.ghosts, 0u);
   const double mass0 = sph::test::mass_by_id(sim.store());
-  // 1 s: about 5 periods of the tank's compression mode (4 H / c0 = 0.2 s, c0 = 22 m/s), the window its second
-  // half. (0.1 s under the sanitizer preset.)
+  // 1 s: 5 periods of the tank's compression mode (4 H / c0 = 0.2 s at c0 = 22 m/s; 10 at 44 m/s), the window
+  // its second half. (0.1 s under the sanitizer preset.)
   const double t_end = sph::test::short_runs() ? 0.1 : 1.0;
   LayerAverage bottom{0.5 * spec.spacing}, mid{0.5 * spec.depth};
   double max_speed = 0.0;
@@ -101,11 +132,20 @@ TEST(StillTank3D, StaysStillAndHydrostatic) {
   // The largest density error of still water is the floor's hydrostatic compression g H / c0^2; noise may add
   // at most as much again.
   EXPECT_LT(d.max_density_error, 2.0 * kG * spec.depth / (c0 * c0));
-  // Time-averaged layer pressure against hydrostatic: the 2D tank's bound (test_still_tank.cpp, 5 %), whose
-  // offset's cause is open; the figures are recorded.
+  // Time-averaged layer pressure. The scheme's own equilibrium sits above hydrostatic by two terms that
+  // docs/METHOD.md derives: 1/N (the lattice's gradient normalisation) and 2 g depth / c0^2 (the equal-mass
+  // hydrostatic start). Issue #18's bound, 1 %, is held against that equilibrium at any settings, and against
+  // hydrostatic itself at the peer's, where both terms are small (0.2 % and 0.25-0.45 %). Not under the
+  // sanitizer preset: its 0.1 s is half a compression period, not an average.
+  if (sph::test::short_runs()) return;
+  const double n = lattice_normalisation(spec.h_factor);
   for (const LayerAverage* avg : {&bottom, &mid}) {
     ASSERT_GT(avg->time, 0.0);
-    EXPECT_NEAR(avg->ratio(), 1.0, 0.05) << "layer at z = " << avg->z0;
+    const double equilibrium = 1.0 / n + 2.0 * kG * (spec.depth - avg->z0) / (c0 * c0);
+    EXPECT_NEAR(avg->ratio(), equilibrium, 0.01) << "layer at z = " << avg->z0;
+    if (std::string(settings.name) == "peer") {
+      EXPECT_NEAR(avg->ratio(), 1.0, 0.01) << "layer at z = " << avg->z0;
+    }
   }
   const auto& w = sim.work();
   testing::Test::RecordProperty("pairs_per_evaluation", std::to_string(static_cast<double>(w.pairs) / static_cast<double>(w.evaluations[0])));
@@ -113,6 +153,11 @@ TEST(StillTank3D, StaysStillAndHydrostatic) {
   testing::Test::RecordProperty("bottom_p_over_hydrostatic", std::to_string(bottom.ratio()));
   testing::Test::RecordProperty("mid_p_over_hydrostatic", std::to_string(mid.ratio()));
 }
+
+INSTANTIATE_TEST_SUITE_P(Settings, StillTank3D,
+                         testing::Values(TankSettings{"paper", 1.2, 10.0},
+                                         TankSettings{"peer", 1.7320508075688772, 20.0}),
+                         [](const testing::TestParamInfo<TankSettings>& info) { return std::string(info.param.name); });
 
 TEST(Determinism3D, SameBitsAtOneAndTwoThreads) {
   sph::Tank3Spec spec;

@@ -5,11 +5,12 @@ pressure offset").
     /usr/bin/python3 tools/still_tank_offset.py [SPHREFINE]
 
 Runs cases/still_tank.json (2D) at mach factors 10, 20 and 40 for its 10 s, frames every 0.05 s, and
-cases/still_tank_3d.json for its 2 s, frames every 0.02 s (one thread each), and prints, per run, the mean pressure
+cases/still_tank_3d.json for its 2 s, frames every 0.02 s, as it is (h = 1.2 d, mach factor 10) and at the peer's
+3D settings (DualSPHysics' CaseDambreak: h = sqrt(3) d, coefsound 20), one thread each, and prints, per run, the mean pressure
 of a band one spacing either side of mid-depth and of the floor row, away from the side walls, over ratio to
 rho0 g (depth - z), time-averaged over the run's second half (many periods of the tank's compression mode),
 beside the prediction 1 / N + 2 g depth / c0^2: N the cubic spline's gradient normalisation on the lattice at
-h = 1.2 d (-sum_j V_j z_ij dW/dz, summed here), depth the band's mean depth.
+the run's h / d (-sum_j V_j z_ij dW/dz, summed here), depth the band's mean depth.
 """
 import glob
 import itertools
@@ -75,11 +76,12 @@ def main():
     tmp = tempfile.mkdtemp(prefix="still_tank_offset_")
     print("| run | mid-depth: measured / predicted | floor: measured / predicted |")
     print("|---|---|---|")
-    runs = [(2, "cases/still_tank.json", m, 0.05) for m in (10, 20, 40)] + [(3, "cases/still_tank_3d.json", 10, 0.02)]
-    for dim, case, mach, frames in runs:
-        folder = os.path.join(tmp, f"{dim}d_{mach}")
-        s = run(app, os.path.join(ROOT, case), [f"material.mach_factor={mach}", f"output.frame_interval={frames}"],
-                folder)
+    runs = [(2, "cases/still_tank.json", m, 0.05, 1.2) for m in (10, 20, 40)] + [
+        (3, "cases/still_tank_3d.json", 10, 0.02, 1.2), (3, "cases/still_tank_3d.json", 20, 0.02, math.sqrt(3))]
+    for dim, case, mach, frames, h_factor in runs:
+        folder = os.path.join(tmp, f"{dim}d_{mach}_{h_factor:.3f}")
+        s = run(app, os.path.join(ROOT, case), [f"material.mach_factor={mach}", f"output.frame_interval={frames}",
+                                                f"h_factor={h_factor!r}"], folder)
         f = s["fluid"][0]
         depth, d = f["hi"][-1], f["spacing"]
         size = np.array(f["hi"][:dim - 1], dtype=float)
@@ -87,11 +89,12 @@ def main():
         v_ref = m.get("reference_speed") or math.sqrt(2 * G * m["reference_height"])
         c0 = m["mach_factor"] * v_ref
         r = bands(folder, dim, depth, d, s["time"]["end"] / 2, 0.2 * size, 0.8 * size)
-        n = normalisation(dim)
+        n = normalisation(dim, h_factor)
         pred = {k: 1 / n + 2 * G * r[k][1] / c0 ** 2 for k in r}
-        print(f"| {dim}D, mach factor {mach} | {r['mid'][0]:.4f} / {pred['mid']:.4f} | "
+        print(f"| {dim}D, h = {h_factor:.3g} d, mach factor {mach} | {r['mid'][0]:.4f} / {pred['mid']:.4f} | "
               f"{r['floor'][0]:.4f} / {pred['floor']:.4f} |")
-    print(f"\nnormalisation at h = 1.2 d: 2D {normalisation(2):.4f}, 3D {normalisation(3):.4f}")
+    print(f"\nnormalisation at h = 1.2 d: 2D {normalisation(2):.4f}, 3D {normalisation(3):.4f}; "
+          f"at h = sqrt(3) d: 3D {normalisation(3, math.sqrt(3)):.4f}")
 
 
 if __name__ == "__main__":
