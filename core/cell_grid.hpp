@@ -162,6 +162,30 @@ class CellGrid {
         sorted_, scratch_);
   }
 
+  /// Orders the particles of each cell by `less(a, b)`, a strict total order on the input indices of the cell's
+  /// particles (e.g. by particle id). The counting sort keeps each cell's particles in their input order; after
+  /// this, the order within a cell, and so every sum that walks the cells, depends on the particles alone and
+  /// not on the order they came in: a shuffled store, or a rank's own share of the particles (issue #19).
+  template <class Less>
+  void order_cells_by(Less&& less) {
+    std::uint32_t* order = sorted_.order.data();
+    const std::uint32_t* start = sorted_.bucket_start.data();
+    par::parallel_for(cells_, [&](std::size_t c) {
+      std::uint32_t* b = order + start[c];
+      std::uint32_t* e = order + start[c + 1];
+      if (e - b > 16) {  // a crowded cell (a grid coarsened to its memory budget): a full sort
+        std::sort(b, e, less);
+        return;
+      }
+      for (std::uint32_t* k = b + 1; k < e; ++k) {  // a few particles, mostly in order already
+        const std::uint32_t item = *k;
+        std::uint32_t* m = k;
+        for (; m > b && less(item, m[-1]); --m) *m = m[-1];
+        *m = item;
+      }
+    });
+  }
+
   /// Source index (in the store before reordering) of the k-th particle in cell order.
   const std::vector<std::uint32_t>& order() const { return sorted_.order; }
   /// cell_start()[c] .. cell_start()[c+1]: particles of cell c (after reordering); layer l's cells follow

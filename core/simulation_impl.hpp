@@ -91,6 +91,17 @@ void SimulationT<D>::build_neighbours(const SmoothingRange& hr) {
   std::array<typename CellGrid<D>::LayerSpec, kGridLayers> spec;
   neighbour_layers<D>(hr, boxes, spec);
   grid_.build_layers(spec.data(), layers, expand_x_.data(), layers > 1 ? expand_layer_.data() : nullptr, m);
+  // Within a cell, by id, and a ghost after its source by image: the order, and so every pair sum, comes from
+  // the particles alone, not from the store's order before the sort (core/cell_grid.hpp, order_cells_by).
+  {
+    const ParticleId* id = view.id;
+    const std::uint32_t* from = expand_src_.data();
+    const std::int8_t* image = expand_image_.data();
+    grid_.order_cells_by([id, from, image](std::uint32_t a, std::uint32_t b) {
+      const ParticleId ia = id[from[a]], ib = id[from[b]];
+      return ia != ib ? ia < ib : image[a] < image[b];
+    });
+  }
   const std::uint32_t* order = grid_.order().data();
   const std::uint32_t* src = expand_src_.data();
   // One gather of every field, then the copies that are ghosts become ghosts.

@@ -157,7 +157,7 @@ TEST_P(StillTank3D, StaysStillAndHydrostatic) {
 INSTANTIATE_TEST_SUITE_P(Settings, StillTank3D,
                          testing::Values(TankSettings{"paper", 1.2, 10.0},
                                          TankSettings{"peer", 1.7320508075688772, 20.0}),
-                         [](const testing::TestParamInfo<TankSettings>& info) { return std::string(info.param.name); });
+                         [](const testing::TestParamInfo<TankSettings>& p) { return std::string(p.param.name); });
 
 TEST(Determinism3D, SameBitsAtOneAndTwoThreads) {
   sph::Tank3Spec spec;
