@@ -105,6 +105,24 @@ BENCHMARK_TEMPLATE(BM_Step_Tank, 2)->Args({10000, 1})->Args({100000, 1})->Args({
 BENCHMARK_TEMPLATE(BM_Step_Tank, 3)->Args({10000, 1})->Args({100000, 1})->Args({1000000, 1})
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// The diagnostics (exact sums, par::ExactSum) against a step of the same tank: written at every output row, so
+// their cost is one row's, not one step's.
+template <int D>
+void BM_Diagnostics_Tank(benchmark::State& state) {
+  omp_set_num_threads(static_cast<int>(state.range(1)));
+  SimulationT<D> sim = tank<D>(static_cast<std::size_t>(state.range(0)));
+  sim.step();
+  double sink = 0.0;
+  for (auto _ : state) sink += sim.diagnostics().kinetic;
+  benchmark::DoNotOptimize(sink);
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * sim.store().size()));
+}
+
+BENCHMARK_TEMPLATE(BM_Diagnostics_Tank, 2)->Args({100000, 1})->Args({1000000, 1})
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_Diagnostics_Tank, 3)->Args({100000, 1})->Args({1000000, 1})
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+
 void sizes(benchmark::internal::Benchmark* b) {
   for (int64_t n : {1000, 10000, 100000, 1000000, 4000000})
     for (int64_t t : {1, 2}) b->Args({n, t});

@@ -1,6 +1,6 @@
 #pragma once
 // Global diagnostics of the fluid: conserved quantities, energies, extremes and counts per level.
-// Every sum is a deterministic chunked reduction, identical at any thread count.
+// Every sum is exact and rounded once (parallel/exact_sum.hpp): the same bits in any order, at any thread count.
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
@@ -12,6 +12,7 @@
 
 #include "core/equation_of_state.hpp"
 #include "core/particle_store.hpp"
+#include "parallel/exact_sum.hpp"
 #include "parallel/parallel_for.hpp"
 
 namespace sph {
@@ -82,11 +83,13 @@ struct CompensatedSum {
 template <int D>
 DiagnosticsT<D> compute_diagnostics(const ParticleStore<D>& store, const TaitEquationOfState& eos,
                                     const Vec<D>& gravity) {
+  // Every sum is exact, rounded once (par::ExactSum): the diagnostics are the same bits whatever the store's order
+  // and however its particles are split between threads or, in a distributed run, between ranks.
   struct Acc {
-    CompensatedSum mass;
-    double ke = 0, pe = 0, el = 0, vmax = 0, derr = 0;
-    Angular<D> L = zero_angular<D>();
-    Vec<D> P = Vec<D>::Zero();
+    par::ExactSum mass, ke, pe, el;
+    std::array<par::ExactSum, D> P{};
+    std::array<par::ExactSum, D == 2 ? 1 : 3> L{};
+    double vmax = 0, derr = 0;
     std::size_t fluid = 0, ghosts = 0, walls = 0;
   };
   const auto& x = store.x.values();
@@ -94,52 +97,58 @@ DiagnosticsT<D> compute_diagnostics(const ParticleStore<D>& store, const TaitEqu
   const auto& m = store.m.values();
   const auto& rho = store.rho.values();
   const auto& kind = store.kind.values();
-  const Acc acc = par::reduce(
+  const Acc acc = par::accumulate(
       store.size(), Acc{},
-      [&](std::size_t i) {
-        Acc a;
+      [&](Acc& a, std::size_t i) {
         if (kind[i] == Kind::ghost) {
-          a.ghosts = 1;
-          return a;
+          ++a.ghosts;
+          return;
         }
         if (kind[i] == Kind::wall) {
-          a.walls = 1;
-          return a;
+          ++a.walls;
+          return;
         }
-        a.fluid = 1;
+        ++a.fluid;
         a.mass.add(m[i]);
-        a.ke = 0.5 * m[i] * v[i].squaredNorm();
-        a.pe = -m[i] * gravity.dot(x[i]);
-        a.el = m[i] * eos.specific_energy(rho[i]);
-        a.P = m[i] * v[i];
-        a.L = m[i] * cross<D>(x[i], v[i]);
-        a.vmax = v[i].norm();
-        a.derr = std::abs(rho[i] / eos.rho0 - 1.0);
-        return a;
+        a.ke.add(0.5 * m[i] * v[i].squaredNorm());
+        a.pe.add(-m[i] * gravity.dot(x[i]));
+        a.el.add(m[i] * eos.specific_energy(rho[i]));
+        const Vec<D> p = m[i] * v[i];
+        for (int k = 0; k < D; ++k) a.P[static_cast<std::size_t>(k)].add(p[k]);
+        const Angular<D> l = m[i] * cross<D>(x[i], v[i]);
+        if constexpr (D == 2) {
+          a.L[0].add(l);
+        } else {
+          for (int k = 0; k < 3; ++k) a.L[static_cast<std::size_t>(k)].add(l[k]);
+        }
+        a.vmax = std::max(a.vmax, v[i].norm());
+        a.derr = std::max(a.derr, std::abs(rho[i] / eos.rho0 - 1.0));
       },
-      [](const Acc& a, const Acc& b) {
-        Acc c;
-        c.mass = a.mass;
-        c.mass.merge(b.mass);
-        c.ke = a.ke + b.ke;
-        c.pe = a.pe + b.pe;
-        c.el = a.el + b.el;
-        c.P = a.P + b.P;
-        c.L = a.L + b.L;
-        c.vmax = std::max(a.vmax, b.vmax);
-        c.derr = std::max(a.derr, b.derr);
-        c.fluid = a.fluid + b.fluid;
-        c.ghosts = a.ghosts + b.ghosts;
-        c.walls = a.walls + b.walls;
-        return c;
+      [](Acc a, const Acc& b) {
+        a.mass.merge(b.mass);
+        a.ke.merge(b.ke);
+        a.pe.merge(b.pe);
+        a.el.merge(b.el);
+        for (std::size_t k = 0; k < a.P.size(); ++k) a.P[k].merge(b.P[k]);
+        for (std::size_t k = 0; k < a.L.size(); ++k) a.L[k].merge(b.L[k]);
+        a.vmax = std::max(a.vmax, b.vmax);
+        a.derr = std::max(a.derr, b.derr);
+        a.fluid += b.fluid;
+        a.ghosts += b.ghosts;
+        a.walls += b.walls;
+        return a;
       });
   DiagnosticsT<D> d;
   d.mass = acc.mass.value();
-  d.kinetic = acc.ke;
-  d.potential = acc.pe;
-  d.elastic = acc.el;
-  d.momentum = acc.P;
-  d.angular_momentum = acc.L;
+  d.kinetic = acc.ke.value();
+  d.potential = acc.pe.value();
+  d.elastic = acc.el.value();
+  for (int k = 0; k < D; ++k) d.momentum[k] = acc.P[static_cast<std::size_t>(k)].value();
+  if constexpr (D == 2) {
+    d.angular_momentum = acc.L[0].value();
+  } else {
+    for (int k = 0; k < 3; ++k) d.angular_momentum[k] = acc.L[static_cast<std::size_t>(k)].value();
+  }
   d.max_speed = acc.vmax;
   d.max_density_error = acc.derr;
   d.fluid = acc.fluid;
