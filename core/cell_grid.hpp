@@ -72,6 +72,12 @@ class CellGrid {
     Box box;
     double cell_size = 1.0;
     double max_h = 0.0;
+    // With `anchored`, the cells lie on a lattice fixed at `anchor` (e.g. below the scene's container): cell
+    // boundaries at anchor + k cell_size, whatever the box. Two grids over different subsets of the particles
+    // (two ranks' shares with their halos) then put a point in the same cell and walk shared cells in the same
+    // order. Points below the anchor fall in its first cell. Without it, the lattice starts at the box's corner.
+    bool anchored = false;
+    VecD anchor = VecD::Zero();
   };
 
   /// Sorts particles into cells of size >= `min_cell_size`, one layer. `max_h` is the largest smoothing length
@@ -146,11 +152,25 @@ class CellGrid {
       L.max_h = spec[l].max_h;
       if (empty(box[l])) continue;
       L.cells = 1;
-      for (int k = 0; k < D; ++k) {
-        L.dims[k] = static_cast<std::int64_t>(std::floor((box[l].hi[k] - box[l].lo[k]) / size[l])) + 1;
-        L.cells *= static_cast<std::size_t>(L.dims[k]);
+      L.anchor = box[l].lo;
+      if (spec[l].anchored) {
+        // The box's cells on the anchored lattice, by the same arithmetic as coords(): offset and dims are whole
+        // cells, so every grid anchored alike numbers a point's cell the same way (up to its own offset).
+        L.anchor = spec[l].anchor;
+        for (int k = 0; k < D; ++k) {
+          L.offset[k] = std::max<std::int64_t>(0, static_cast<std::int64_t>((box[l].lo[k] - L.anchor[k]) * L.inv_cell));
+          const auto top = static_cast<std::int64_t>((box[l].hi[k] - L.anchor[k]) * L.inv_cell);
+          L.dims[k] = std::max<std::int64_t>(1, top - L.offset[k] + 1);
+          L.origin[k] = L.anchor[k] + static_cast<double>(L.offset[k]) * size[l];
+          L.cells *= static_cast<std::size_t>(L.dims[k]);
+        }
+      } else {
+        for (int k = 0; k < D; ++k) {
+          L.dims[k] = static_cast<std::int64_t>(std::floor((box[l].hi[k] - box[l].lo[k]) / size[l])) + 1;
+          L.cells *= static_cast<std::size_t>(L.dims[k]);
+        }
+        L.origin = box[l].lo;
       }
-      L.origin = box[l].lo;
       cells_ += L.cells;
     }
     par::counting_sort(
@@ -251,13 +271,15 @@ class CellGrid {
     double cell_size = 1.0;
     double inv_cell = 1.0;
     double max_h = 0.0;
-    VecD origin = VecD::Zero();
+    VecD origin = VecD::Zero();  // the first cell's corner: anchor + offset cell_size
     std::array<std::int64_t, D> dims{};
+    VecD anchor = VecD::Zero();             // the lattice's origin (the box's corner when not anchored)
+    std::array<std::int64_t, D> offset{};  // the first cell's index on that lattice (>= 0)
 
     std::array<std::int64_t, D> coords(const VecD& p) const {
       std::array<std::int64_t, D> c{};
       for (int k = 0; k < D; ++k) {
-        auto ck = static_cast<std::int64_t>((p[k] - origin[k]) * inv_cell);
+        auto ck = static_cast<std::int64_t>((p[k] - anchor[k]) * inv_cell) - offset[k];
         c[k] = std::clamp<std::int64_t>(ck, 0, dims[k] - 1);
       }
       return c;

@@ -119,12 +119,21 @@ int neighbour_layers(const SmoothingRange& r, const LayerBoxes<D>& boxes,
   return count;
 }
 
+/// Where the step's cell lattice is anchored (CellGrid::LayerSpec::anchor): one container size below the
+/// container's lower corner, below any ghost. A function of the scene alone, so that a grid over part of the
+/// particles (a rank's share and its halo, issue #19) cuts its cells where the whole grid does.
+template <class Container>
+auto grid_anchor(const Container& container) {
+  return (container.lo - (container.hi - container.lo)).eval();
+}
+
 /// The solver's layered grid over a store as it stands (not reordered): the layers of neighbour_layers(), each
-/// particle in the layer of its level (`layer` receives them). For queries between steps (refinement's
-/// NeighbourQuery) and the tests; the step builds its grid over the ghost-expanded set in the same way
-/// (Simulation::build_neighbours), reducing the boxes in its expansion loop.
+/// particle in the layer of its level (`layer` receives them), on the lattice anchored at `anchor` when given.
+/// For queries between steps (refinement's NeighbourQuery) and the tests; the step builds its grid over the
+/// ghost-expanded set in the same way (Simulation::build_neighbours), reducing the boxes in its expansion loop.
 template <int D>
-void build_level_grid(const ParticleStore<D>& store, CellGrid<D>& grid, std::vector<std::uint8_t>& layer) {
+void build_level_grid(const ParticleStore<D>& store, CellGrid<D>& grid, std::vector<std::uint8_t>& layer,
+                      const Vec<D>* anchor = nullptr) {
   using Box = typename CellGrid<D>::Box;
   const SmoothingRange hr = smoothing_range(store);
   const int layers = hr.layers();
@@ -140,6 +149,12 @@ void build_level_grid(const ParticleStore<D>& store, CellGrid<D>& grid, std::vec
       [](const LayerBoxes<D>& a, const LayerBoxes<D>& b) { return merged<D>(a, b); });
   std::array<typename CellGrid<D>::LayerSpec, kGridLayers> spec;
   neighbour_layers<D>(hr, boxes, spec);
+  if (anchor != nullptr) {
+    for (int l = 0; l < layers; ++l) {
+      spec[static_cast<std::size_t>(l)].anchored = true;
+      spec[static_cast<std::size_t>(l)].anchor = *anchor;
+    }
+  }
   grid.build_layers(spec.data(), layers, store.x.data(), layer.data(), n);
 }
 

@@ -90,6 +90,14 @@ void SimulationT<D>::build_neighbours(const SmoothingRange& hr) {
   // (core/neighbour_cells.hpp).
   std::array<typename CellGrid<D>::LayerSpec, kGridLayers> spec;
   neighbour_layers<D>(hr, boxes, spec);
+  // Cells on a lattice fixed by the container (grid_anchor): a point's cell is a function of the point and the
+  // scene, not of which particles the grid holds, so a grid over part of the particles (a rank's share and its
+  // halo, issue #19) walks the cells they share in the same order.
+  const Vec<D> anchor = grid_anchor(settings_.geometry.container);
+  for (int l = 0; l < layers; ++l) {
+    spec[static_cast<std::size_t>(l)].anchored = true;
+    spec[static_cast<std::size_t>(l)].anchor = anchor;
+  }
   grid_.build_layers(spec.data(), layers, expand_x_.data(), layers > 1 ? expand_layer_.data() : nullptr, m);
   // Within a cell, by id, and a ghost after its source by image: the order, and so every pair sum, comes from
   // the particles alone, not from the store's order before the sort (core/cell_grid.hpp, order_cells_by).
