@@ -19,6 +19,14 @@ class NeighbourQueryIn {
     // The step's cells and layers (core/neighbour_cells.hpp). The store may still hold the last step's ghosts,
     // of a level no fluid has any more: they go to the deepest layer there is (the query skips them anyway).
     build_level_grid(store, grid_, layer_);
+    // Each cell in id order, as in the step (ghosts of one source share its id; the queries skip them): a query
+    // meets equal candidates, such as RSP's equally near lattice neighbours, in an order of the particles' own,
+    // whatever the store's order.
+    const ParticleId* id = store.id.data();
+    const Kind* kind = store.kind.data();
+    grid_.order_cells_by([id, kind](std::uint32_t a, std::uint32_t b) {
+      return id[a] != id[b] ? id[a] < id[b] : kind[a] < kind[b];
+    });
   }
 
   /// Calls f(j, r) for every fluid particle j != i with r_ij < 2 h_ij, in a fixed order.
