@@ -32,16 +32,17 @@ struct ShareResult {
 
 /// The sweep over the share of [x_lo, x_hi) (its particles and those within `halo` of it, in the whole store's
 /// order) on a grid of its own, against the whole store's rates.
-ShareResult sweep_share(const Simulation& sim, double x_lo, double x_hi, double halo, bool anchored) {
-  const ParticleStore<2>& all = sim.store();
+template <int D>
+ShareResult sweep_share(const SimulationT<D>& sim, double x_lo, double x_hi, double halo, bool anchored) {
+  const ParticleStore<D>& all = sim.store();
   std::vector<std::uint32_t> pick;
   for (std::size_t i = 0; i < all.size(); ++i)
     if (all.x[i][0] >= x_lo - halo && all.x[i][0] < x_hi + halo) pick.push_back(static_cast<std::uint32_t>(i));
-  ParticleStore<2> share = all;
+  ParticleStore<D> share = all;
   share.gather(pick);
-  CellGrid<2> grid;
+  CellGrid<D> grid;
   std::vector<std::uint8_t> layer;
-  const Vec<2> anchor = grid_anchor(sim.settings().geometry.container);
+  const Vec<D> anchor = grid_anchor(sim.settings().geometry.container);
   build_level_grid(share, grid, layer, anchored ? &anchor : nullptr);
   std::vector<std::uint32_t> from(share.size());  // share position -> whole store index
   for (std::size_t k = 0; k < share.size(); ++k) from[k] = pick[grid.order()[k]];
@@ -83,6 +84,28 @@ TEST(Partition, ARegionAndItsHaloSweepToTheBitsOfTheWhole) {
     // The same share on a lattice from its own box: the test can tell.
     const ShareResult own = sweep_share(sim, cuts[r], cuts[r + 1], halo, false);
     EXPECT_GT(own.differing, 0u) << "a grid cut at the share's own corner gave the same bits";
+  }
+  EXPECT_EQ(fluid, sim.diagnostics().fluid);
+}
+
+TEST(Partition, ThreeDimensionalSharesSweepToTheBitsOfTheWhole) {
+  // DualSPHysics' 3D dam break with its column (cases/dam_break_3d.json: ghosts in corners, wall particles on every
+  // face and on the column), set in motion; shares along x, the middle one holding the column.
+  const auto cases = std::filesystem::path(__FILE__).parent_path().parent_path() / "cases";
+  SimulationT<3> sim = scene::build_simulation<3>(scene::load_scene(cases / "dam_break_3d.json"));
+  for (int k = 0; k < 20; ++k) sim.step();
+  sim.refresh();
+  const double halo = 2.0 * test::max_h(sim.store());
+  const double cuts[] = {-1.0, 0.25, 0.95, 2.0};
+  std::size_t fluid = 0;
+  for (int r = 0; r < 3; ++r) {
+    SCOPED_TRACE("share [" + std::to_string(cuts[r]) + ", " + std::to_string(cuts[r + 1]) + ")");
+    const ShareResult anchored = sweep_share(sim, cuts[r], cuts[r + 1], halo, true);
+    EXPECT_EQ(anchored.differing, 0u) << "of " << anchored.fluid;
+    fluid += anchored.fluid;
+    if (anchored.fluid > 0) {
+      EXPECT_GT(sweep_share(sim, cuts[r], cuts[r + 1], halo, false).differing, 0u);
+    }
   }
   EXPECT_EQ(fluid, sim.diagnostics().fluid);
 }
