@@ -63,23 +63,6 @@ struct DiagnosticsT {
 };
 using Diagnostics = DiagnosticsT<2>;
 
-/// Neumaier-compensated sum: its result is the exact sum correctly rounded in all but pathological cases,
-/// so it does not change when the particles are reordered or split (mass is compared with ==).
-struct CompensatedSum {
-  double sum = 0.0, c = 0.0;
-  void add(double x) {
-    const double t = sum + x;
-    c += std::abs(sum) >= std::abs(x) ? (sum - t) + x : (x - t) + sum;
-    sum = t;
-  }
-  CompensatedSum& merge(const CompensatedSum& o) {
-    add(o.sum);
-    add(o.c);
-    return *this;
-  }
-  double value() const { return sum + c; }
-};
-
 template <int D>
 DiagnosticsT<D> compute_diagnostics(const ParticleStore<D>& store, const TaitEquationOfState& eos,
                                     const Vec<D>& gravity) {

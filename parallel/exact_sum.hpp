@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <vector>
 
 namespace sph::par {
 
@@ -53,6 +54,20 @@ class ExactSum {
     pending_ += o.pending_;
     count();
     return *this;
+  }
+
+  /// The exact sum as doubles whose exact sum it is: the rounded sum, then the rounded remainder, and so on until
+  /// nothing remains (a few for sums of like magnitudes). Adding them to an empty ExactSum restores this one's
+  /// value exactly: the form a checkpoint keeps. Empty for zero; the special sum alone when Inf or NaN was added.
+  std::vector<double> parts() const {
+    if (special_ != 0.0 || std::isnan(special_)) return {special_};
+    std::vector<double> out;
+    ExactSum rest = *this;
+    for (double v = rest.value(); v != 0.0 && std::isfinite(v); v = rest.value()) {
+      out.push_back(v);
+      rest.add(-v);
+    }
+    return out;
   }
 
   /// The exact sum rounded to the nearest double (ties to even); +-Inf beyond the largest double.

@@ -255,7 +255,7 @@ TEST(Refinement3D, DynamicDamBreakRefinesConservesMassAndIsThreadIndependent) {
       const auto d = sim.diagnostics();
       SCOPED_TRACE(testing::Message() << "threads " << threads << ", per level " << (stepping == sph::TimeStepping::per_level)
                                       << ": " << d.fluid << " fluid, per level " << d.per_level.size());
-      EXPECT_EQ(d.mass, m0) << "splits give m/8 exactly and the diagnostics' mass is a compensated sum";
+      EXPECT_EQ(d.mass, m0) << "splits give m/8 exactly and the diagnostics' mass is an exact sum";
       ASSERT_GE(d.per_level.size(), 2u);
       EXPECT_GT(d.per_level[1], sph::test::short_runs() ? 16u : 100u) << "the fast front is refined";
       sim.remove_ghosts();

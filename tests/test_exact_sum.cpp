@@ -112,4 +112,26 @@ TEST(ExactSum, SameBitsInAnyOrderAndAnySplit) {
                same_bits(std::accumulate(xs.rbegin(), xs.rend(), 0.0), plain));
 }
 
+TEST(ExactSum, ItsPartsRestoreItExactly) {
+  // A checkpoint keeps the parts; a resumed run adds them to an empty sum and must go on as the uninterrupted
+  // one: the same value after the same later additions.
+  std::mt19937_64 rng(13);
+  ExactSum s;
+  for (int k = 0; k < 1000; ++k) s.add(std::ldexp(std::uniform_real_distribution<double>(0.5, 1.0)(rng),
+                                                 std::uniform_int_distribution<int>(-60, 60)(rng)));
+  const std::vector<double> parts = s.parts();
+  ASSERT_GE(parts.size(), 2u) << "a sum that one double cannot hold";
+  ExactSum restored;
+  for (double p : parts) restored.add(p);
+  EXPECT_EQ(restored.parts(), parts);
+  for (int k = 0; k < 100; ++k) {
+    const double x = std::ldexp(1.0, -70 - k);
+    s.add(x);
+    restored.add(x);
+  }
+  EXPECT_TRUE(same_bits(restored.value(), s.value()));
+  EXPECT_EQ(restored.parts(), s.parts());
+  EXPECT_TRUE(ExactSum{}.parts().empty());
+}
+
 }  // namespace

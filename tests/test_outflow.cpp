@@ -4,6 +4,7 @@
 // (M + removed mass = M0), the result is bitwise identical at 1 and 2 threads and on --resume, and with the
 // default ("stop") the same scene is stopped by the watchdog with the open-top message.
 #include <gtest/gtest.h>
+#include <hdf5.h>
 #include <nlohmann/json.hpp>
 #include <omp.h>
 
@@ -205,7 +206,7 @@ std::map<std::string, std::vector<double>> series(const fs::path& file) {
   return out;
 }
 
-// M (a compensated sum over the particles left), the removed mass (a compensated sum over those removed) and M0
+// M (an exact sum over the particles left, rounded once), the removed mass (the same over those removed) and M0
 // are each the exact sum of their masses correctly rounded, so M + removed differs from M0 by the three roundings
 // and that of the addition: at most 2 ulp of M0.
 constexpr double kMassBalance = 2.0 * std::numeric_limits<double>::epsilon();
@@ -352,6 +353,60 @@ TEST(Outflow, RemovalIsBitwiseIdenticalAtOneAndTwoThreadsAndOnResume) {
   }
   EXPECT_EQ(one.simulation().removed().particles, kThrown);
   EXPECT_EQ(lines(c_dir / "series.csv"), lines(a_dir / "series.csv"));
+}
+
+TEST(Outflow, ACheckpointWithTheOlderCompensatedRemovedMassResumesAsTheUninterruptedRun) {
+  // Checkpoints written before the exact sum hold the removed mass as a compensated sum's value and compensation
+  // (attributes removed_mass, removed_mass_compensation). Read as the two parts of an exact sum, they are the
+  // same number when it fits in two doubles (here a few hundred equal masses): the resumed run ends bitwise
+  // where the uninterrupted one does.
+  TempFolder tmp;
+  omp_set_num_threads(1);
+  const scene::Scene s = thrown_scene("remove");
+  scene::Runner whole(s, scene::RunOptions{});
+  whole.run();
+  const fs::path dir = tmp.path() / "run";
+  {
+    scene::Runner first(s, scene::RunOptions{dir, std::nullopt, 0.07});
+    first.start();
+    while (!fs::exists(io::RunFiles{dir}.checkpoint())) first.advance();
+    ASSERT_GT(first.simulation().removed().particles, 0u);
+    ASSERT_LE(first.simulation().removed().mass.parts().size(), 2u);
+  }
+  // The checkpoint rewritten in the older form.
+  {
+    const hid_t f = H5Fopen(io::RunFiles{dir}.checkpoint().c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(f, 0);
+    const hid_t g = H5Gopen2(f, "checkpoint", H5P_DEFAULT);
+    ASSERT_GE(g, 0);
+    const hid_t a = H5Aopen(g, "removed_mass_parts", H5P_DEFAULT);
+    ASSERT_GE(a, 0);
+    const hid_t space = H5Aget_space(a);
+    std::vector<double> parts(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space)));
+    if (!parts.empty()) {
+      ASSERT_GE(H5Aread(a, H5T_NATIVE_DOUBLE, parts.data()), 0);
+    }
+    H5Sclose(space);
+    H5Aclose(a);
+    ASSERT_GE(H5Adelete(g, "removed_mass_parts"), 0);
+    parts.resize(2, 0.0);
+    const char* names[] = {"removed_mass", "removed_mass_compensation"};
+    for (int k = 0; k < 2; ++k) {
+      const hid_t scalar = H5Screate(H5S_SCALAR);
+      const hid_t attr = H5Acreate2(g, names[k], H5T_NATIVE_DOUBLE, scalar, H5P_DEFAULT, H5P_DEFAULT);
+      ASSERT_GE(H5Awrite(attr, H5T_NATIVE_DOUBLE, &parts[static_cast<std::size_t>(k)]), 0);
+      H5Aclose(attr);
+      H5Sclose(scalar);
+    }
+    H5Gclose(g);
+    H5Fclose(f);
+  }
+  scene::Runner resumed(s, scene::RunOptions{dir, io::RunFiles{dir}.checkpoint(), 0.07});
+  resumed.run();
+  EXPECT_EQ(resumed.simulation().step_count(), whole.simulation().step_count());
+  expect_bitwise_equal(resumed.simulation().store(), whole.simulation().store());
+  EXPECT_EQ(resumed.simulation().removed().particles, whole.simulation().removed().particles);
+  EXPECT_EQ(resumed.simulation().removed().mass.parts(), whole.simulation().removed().mass.parts());
 }
 
 }  // namespace

@@ -5,7 +5,7 @@
 //   - every fluid particle in the fluid domain (inside the container, outside every obstacle);
 //   - the density error max |rho/rho0 - 1| below the case's bound (stated with its reason in the table);
 //   - the fluid mass equal (==) to the initial mass (refinement splits m into four exact quarters, and the
-//     diagnostics sum is compensated, so it is exactly reproducible);
+//     diagnostics sum is exact and rounded once, so it is exactly reproducible);
 //   - the total energy E = kinetic + potential + elastic (Diagnostics::total_energy) + Lennard-Jones wall
 //     energy (lennard_jones_energy) never above E(0) + tolerance (see kEnergyRise below).
 // Then the same run at 1 thread must end in the bitwise same state as at 2 threads (every field, by id).

@@ -159,7 +159,7 @@ def main():
         series = read_output.load_series(removed)
         check(s.get("status") == "completed", f"removed run: status {s.get('status')}")
         check(s.get("removed") == 12 and series["fluid"][-1] == 0, f"removed {s.get('removed')}, fluid {series['fluid'][-1]}")
-        # M is 0 at the end and the removed mass a compensated sum of the same 12 masses: equal up to rounding.
+        # M is 0 at the end and the removed mass an exact sum of the same 12 masses: equal up to rounding.
         check(abs(s["mass_drift"]) <= 2 * np.finfo(float).eps, f"mass drift with removed fluid {s['mass_drift']}")
         check(s["summary"]["removed_particles"] == 12, f"run.json removed {s['summary'].get('removed_particles')}")
     finally:

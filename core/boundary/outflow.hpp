@@ -11,14 +11,16 @@
 #include "core/boundary/wall.hpp"
 #include "core/diagnostics.hpp"
 #include "core/particle_store.hpp"
+#include "parallel/exact_sum.hpp"
 
 namespace sph {
 
-/// Fluid removed through the open top: how many particles and their mass (compensated, so the running total
-/// is the exact sum correctly rounded whatever the order of the removals). Part of the run's state.
+/// Fluid removed through the open top: how many particles and their mass (an exact sum, so the running total is
+/// the same bits whatever the order of the removals, and however they are split between threads or ranks). Part
+/// of the run's state.
 struct RemovedFluid {
   std::uint64_t particles = 0;
-  CompensatedSum mass;
+  par::ExactSum mass;
 
   RemovedFluid& add(const RemovedFluid& more) {
     particles += more.particles;

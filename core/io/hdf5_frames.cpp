@@ -95,6 +95,25 @@ void write_attribute(hid_t object, const char* name, hid_t type, const T& value)
   check(H5Awrite(attr, type, &value), std::string("write attribute ") + name);
 }
 
+void write_double_array_attribute(hid_t object, const char* name, const std::vector<double>& values) {
+  const hsize_t count = values.size();
+  const Handle space(count == 0 ? H5Screate(H5S_NULL) : H5Screate_simple(1, &count, nullptr), H5Sclose,
+                     "create a dataspace");
+  const Handle attr(H5Acreate2(object, name, H5T_NATIVE_DOUBLE, space, kDefault, kDefault), H5Aclose,
+                    std::string("create attribute ") + name);
+  if (count > 0) check(H5Awrite(attr, H5T_NATIVE_DOUBLE, values.data()), std::string("write attribute ") + name);
+}
+
+std::vector<double> read_double_array_attribute(hid_t object, const char* name) {
+  const Handle attr(H5Aopen(object, name, kDefault), H5Aclose, std::string("open attribute ") + name);
+  const Handle space(H5Aget_space(attr), H5Sclose, std::string("get the dataspace of attribute ") + name);
+  const hssize_t count = H5Sget_simple_extent_npoints(space);
+  if (count < 0) throw std::runtime_error(std::string("HDF5: cannot size attribute ") + name);
+  std::vector<double> values(static_cast<std::size_t>(count));
+  if (count > 0) check(H5Aread(attr, H5T_NATIVE_DOUBLE, values.data()), std::string("read attribute ") + name);
+  return values;
+}
+
 void write_string_attribute(hid_t object, const char* name, const std::string& value) {
   const Handle type(H5Tcopy(H5T_C_S1), H5Tclose, "copy the string type");
   check(H5Tset_size(type, std::max<std::size_t>(1, value.size())), "size a string type");
@@ -291,8 +310,7 @@ void write_checkpoint(const std::filesystem::path& file, const ParticleStore<D>&
     if (D == 3) write_attribute(g, "initial_momentum_z", H5T_NATIVE_DOUBLE, state.initial_momentum_z);
     write_attribute(g, "dimension", H5T_NATIVE_UINT64, static_cast<std::uint64_t>(D));
     write_attribute(g, "removed_particles", H5T_NATIVE_UINT64, state.removed_particles);
-    write_attribute(g, "removed_mass", H5T_NATIVE_DOUBLE, state.removed_mass);
-    write_attribute(g, "removed_mass_compensation", H5T_NATIVE_DOUBLE, state.removed_mass_compensation);
+    write_double_array_attribute(g, "removed_mass_parts", state.removed_mass_parts);
     write_attribute(g, "particles", H5T_NATIVE_UINT64, static_cast<std::uint64_t>(keep.size()));
     write_string_attribute(g, "scene", state.scene);
     store.for_each_field([&](const auto& field) { write_dataset(g, field, gathered(field, keep)); });
@@ -352,8 +370,12 @@ CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore
   // Absent from checkpoints written before outflow removal existed: nothing was removed then.
   if (has_attribute(g, "removed_particles")) {
     s.removed_particles = read_attribute<std::uint64_t>(g, "removed_particles", H5T_NATIVE_UINT64);
-    s.removed_mass = read_attribute<double>(g, "removed_mass", H5T_NATIVE_DOUBLE);
-    s.removed_mass_compensation = read_attribute<double>(g, "removed_mass_compensation", H5T_NATIVE_DOUBLE);
+    if (has_attribute(g, "removed_mass_parts")) {
+      s.removed_mass_parts = read_double_array_attribute(g, "removed_mass_parts");
+    } else {  // written with a compensated sum (before the exact one): its value and compensation, summed exactly
+      s.removed_mass_parts = {read_attribute<double>(g, "removed_mass", H5T_NATIVE_DOUBLE),
+                              read_attribute<double>(g, "removed_mass_compensation", H5T_NATIVE_DOUBLE)};
+    }
   }
   s.scene = read_string_attribute(g, "scene");
   const auto n = read_attribute<std::uint64_t>(g, "particles", H5T_NATIVE_UINT64);

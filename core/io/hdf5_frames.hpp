@@ -66,8 +66,9 @@ struct CheckpointState {
   double initial_momentum_y = 0.0;
   double initial_momentum_z = 0.0;  // 3D only
   std::uint64_t removed_particles = 0;     // fluid removed through the open top so far (Simulation::removed)
-  double removed_mass = 0.0;               // its mass: the compensated sum's value and compensation, so a
-  double removed_mass_compensation = 0.0;  // resumed run adds later removals exactly as the uninterrupted one
+  // Its mass as the exact sum's parts (par::ExactSum::parts), so a resumed run adds later removals exactly as the
+  // uninterrupted one does.
+  std::vector<double> removed_mass_parts;
   std::string scene;             // the scene (JSON) the run was started from
 };
 

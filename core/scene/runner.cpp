@@ -86,8 +86,7 @@ RunnerT<D>::RunnerT(Scene scene, RunOptions options)
     if constexpr (D == 3) initial_momentum_[2] = state.initial_momentum_z;
     RemovedFluid removed;
     removed.particles = state.removed_particles;
-    removed.mass.sum = state.removed_mass;
-    removed.mass.c = state.removed_mass_compensation;
+    for (double part : state.removed_mass_parts) removed.mass.add(part);
     sim_.set_removed(removed);
     last_row_step_ = last_frame_step_ = last_checkpoint_step_ = state.step;
     resumed_ = true;
@@ -285,8 +284,7 @@ void RunnerT<D>::write_checkpoint() {
   s.initial_momentum_y = initial_momentum_[1];
   if constexpr (D == 3) s.initial_momentum_z = initial_momentum_[2];
   s.removed_particles = sim_.removed().particles;
-  s.removed_mass = sim_.removed().mass.sum;
-  s.removed_mass_compensation = sim_.removed().mass.c;
+  s.removed_mass_parts = sim_.removed().mass.parts();
   s.scene = scene_to_json(scene_).dump();
   io::write_checkpoint(files_.checkpoint(), sim_.store(), s);
   last_checkpoint_step_ = s.step;
