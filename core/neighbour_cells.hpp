@@ -104,10 +104,11 @@ LayerBoxes<D> merged(const LayerBoxes<D>& a, const LayerBoxes<D>& b) {
 
 /// The layers of the neighbour grid for a range and the layers' boxes: layer l holds refinement level l (the
 /// last one the deeper levels too); its cells are sized by its own finest fluid h (a layer without fluid, such
-/// as walls alone, by the finest overall) and its queries reach h_i + its largest h. Returns the layer count.
+/// as walls alone, by the finest overall) and its queries reach h_i + its largest h. With `anchor`, every layer's
+/// cells lie on the lattice anchored there (grid_anchor below). Returns the layer count.
 template <int D>
 int neighbour_layers(const SmoothingRange& r, const LayerBoxes<D>& boxes,
-                     std::array<typename CellGrid<D>::LayerSpec, kGridLayers>& spec) {
+                     std::array<typename CellGrid<D>::LayerSpec, kGridLayers>& spec, const Vec<D>* anchor = nullptr) {
   const int count = r.layers();
   for (int l = 0; l < count; ++l) {
     const auto k = static_cast<std::size_t>(l);
@@ -115,6 +116,8 @@ int neighbour_layers(const SmoothingRange& r, const LayerBoxes<D>& boxes,
     spec[k].box = boxes[k];
     spec[k].cell_size = fluid ? kCellPerFinestH * r.layer_min[k] : neighbour_cell_size(r);
     spec[k].max_h = r.layer_max[k];
+    spec[k].anchored = anchor != nullptr;
+    if (anchor != nullptr) spec[k].anchor = *anchor;
   }
   return count;
 }
@@ -148,13 +151,7 @@ void build_level_grid(const ParticleStore<D>& store, CellGrid<D>& grid, std::vec
       },
       [](const LayerBoxes<D>& a, const LayerBoxes<D>& b) { return merged<D>(a, b); });
   std::array<typename CellGrid<D>::LayerSpec, kGridLayers> spec;
-  neighbour_layers<D>(hr, boxes, spec);
-  if (anchor != nullptr) {
-    for (int l = 0; l < layers; ++l) {
-      spec[static_cast<std::size_t>(l)].anchored = true;
-      spec[static_cast<std::size_t>(l)].anchor = *anchor;
-    }
-  }
+  neighbour_layers<D>(hr, boxes, spec, anchor);
   grid.build_layers(spec.data(), layers, store.x.data(), layer.data(), n);
 }
 

@@ -89,29 +89,21 @@ void SimulationT<D>::build_neighbours(const SmoothingRange& hr) {
   // present, each with cells sized by its finest support and queries reaching h_i + its largest h
   // (core/neighbour_cells.hpp).
   std::array<typename CellGrid<D>::LayerSpec, kGridLayers> spec;
-  neighbour_layers<D>(hr, boxes, spec);
   // Cells on a lattice fixed by the container (grid_anchor): a point's cell is a function of the point and the
   // scene, not of which particles the grid holds, so a grid over part of the particles (a rank's share and its
   // halo, issue #19) walks the cells they share in the same order.
   const Vec<D> anchor = grid_anchor(settings_.geometry.container);
-  for (int l = 0; l < layers; ++l) {
-    spec[static_cast<std::size_t>(l)].anchored = true;
-    spec[static_cast<std::size_t>(l)].anchor = anchor;
-  }
+  neighbour_layers<D>(hr, boxes, spec, &anchor);
   grid_.build_layers(spec.data(), layers, expand_x_.data(), layers > 1 ? expand_layer_.data() : nullptr, m);
   // Within a cell, by id, and a ghost after its source by image: the order, and so every pair sum, comes from
   // the particles alone, not from the store's order before the sort (core/cell_grid.hpp, order_cells_by).
-  {
-    const ParticleId* id = view.id;
-    const std::uint32_t* from = expand_src_.data();
-    const std::int8_t* image = expand_image_.data();
-    grid_.order_cells_by([id, from, image](std::uint32_t a, std::uint32_t b) {
-      const ParticleId ia = id[from[a]], ib = id[from[b]];
-      return ia != ib ? ia < ib : image[a] < image[b];
-    });
-  }
-  const std::uint32_t* order = grid_.order().data();
   const std::uint32_t* src = expand_src_.data();
+  const std::int8_t* images = expand_image_.data();
+  grid_.order_cells_by([id = view.id, src, images](std::uint32_t a, std::uint32_t b) {
+    const ParticleId ia = id[src[a]], ib = id[src[b]];
+    return ia != ib ? ia < ib : images[a] < images[b];
+  });
+  const std::uint32_t* order = grid_.order().data();
   // One gather of every field, then the copies that are ghosts become ghosts.
   store_.gather(m, [order, src](std::size_t k) { return src[order[k]]; });
   if (ghosts_) {
