@@ -177,13 +177,16 @@ void read_dataset(hid_t group, const std::string& name, std::vector<T>& values) 
   if (!values.empty()) check(H5Dread(set, Tr::type(), H5S_ALL, H5S_ALL, kDefault, values.data()), "read dataset " + name);
 }
 
+/// The particles a file holds (fluid and walls: not ghosts, not halos), in id order: the order is the particles'
+/// own, not the store's, so a frame is the same file at any thread count and any rank count (issue #19).
 template <int D>
 std::vector<std::size_t> non_ghosts(const ParticleStore<D>& store) {
   std::vector<std::size_t> keep;
   keep.reserve(store.size());
   for (std::size_t i = 0; i < store.size(); ++i) {
-    if (store.kind[i] != Kind::ghost) keep.push_back(i);
+    if (store.kind[i] == Kind::fluid || store.kind[i] == Kind::wall) keep.push_back(i);
   }
+  std::sort(keep.begin(), keep.end(), [&](std::size_t a, std::size_t b) { return store.id[a] < store.id[b]; });
   return keep;
 }
 

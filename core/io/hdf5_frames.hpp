@@ -2,8 +2,8 @@
 // HDF5 frames and checkpoints, written through the store's field registry so that no field is forgotten.
 //
 // A frame file holds one group (named like "frame_000012") with one dataset per particle field (named
-// after the field: "position" N x D (D = 2 or 3), "density" N, "level" N, ...) for every particle except ghosts, in
-// store order, each with a `units` attribute (the field's unit, ParticleStore), and the attributes time,
+// after the field: "position" N x D (D = 2 or 3), "density" N, "level" N, ...) for every fluid and wall particle (not ghosts, not
+// halos), in id order, each with a `units` attribute (the field's unit, ParticleStore), and the attributes time,
 // time_units ("s"), step, frame and particles. A checkpoint file holds group "checkpoint" with every field
 // (with units too) and the whole state needed to continue bitwise identically. Every file
 // is written under a temporary name and renamed when complete (core/io/atomic_file.hpp).

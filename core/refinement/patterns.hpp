@@ -80,11 +80,15 @@ template <int D>
 ReferenceIn<D> find_reference(const ParticleStore<D>& store, const NeighbourQueryIn<D>& query, std::size_t i) {
   ReferenceIn<D> ref;
   double best = -1.0;
+  ParticleId best_id = 0;
   query.for_each_fluid_neighbour(i, [&](std::size_t j, double r) {
     if (r <= 0.0) return;
     const double F = 0.5 * (store.d[i] + store.d[j]) / r;
-    if (F > best) {  // strict: the first of equal F in the fixed traversal order wins
+    // Of equal F (a lattice's equally near neighbours), the lowest id: the choice is the particles' own, whatever
+    // order the query visits them in (on a rank, its grid holds only part of the particles, issue #19).
+    if (F > best || (F == best && store.id[j] < best_id)) {
       best = F;
+      best_id = store.id[j];
       ref.found = true;
       ref.F = F;
       ref.direction = (store.x[j] - store.x[i]) / r;
