@@ -21,6 +21,7 @@
 #include "core/scene/runner.hpp"
 #include "core/scene/scene_builder.hpp"
 #include "core/scene/scene_parser.hpp"
+#include "parallel/comm.hpp"
 
 namespace sph::app {
 
@@ -209,11 +210,14 @@ void run_scene(const scene::Scene& s, const scene::RunOptions& options, const Ru
                const io::RunFiles& files, const std::filesystem::path& folder, ProgressPrinter& progress) {
   {
     scene::RunnerT<D> runner(s, options);
-    if (args.force && args.resume.empty()) files.clear_run();
-    if (!args.quiet) {
+    const par::Comm& comm = par::Comm::world();
+    if (args.force && args.resume.empty() && comm.root()) files.clear_run();
+    const std::size_t fluid = runner.simulation().diagnostics().fluid;  // collective when distributed
+    if (!args.quiet && comm.root()) {
       std::printf("sphrefine %s: %s (%dD), %zu fluid particles, threads %d, sweep %s -> %s\n", SPH_VERSION,
-                  s.name.c_str(), D, runner.simulation().diagnostics().fluid, omp_get_max_threads(),
-                  runner.simulation().sweep_name(), folder.string().c_str());
+                  s.name.c_str(), D, fluid, omp_get_max_threads(), runner.simulation().sweep_name(),
+                  folder.string().c_str());
+      if (comm.distributed()) std::printf("ranks %d (cells cut by Zoltan RCB)\n", comm.size());
       if (options.resume) {
         std::printf("resuming from %s at t = %.6g s (step %llu)\n", args.resume.c_str(), runner.simulation().time(),
                     static_cast<unsigned long long>(runner.simulation().step_count()));
@@ -222,7 +226,7 @@ void run_scene(const scene::Scene& s, const scene::RunOptions& options, const Ru
     }
     const scene::RunSummaryT<D> summary = runner.run([&](const scene::Progress& p) { progress(p); });
     progress.done();
-    print_summary<D>(s, summary, folder);
+    if (comm.root()) print_summary<D>(s, summary, folder);
   }
 }
 
@@ -285,7 +289,10 @@ int run_command(const RunArguments& args) {
   if (!args.resume.empty()) options.resume = args.resume;
   if (args.checkpoint_every > 0.0) options.checkpoint_interval = args.checkpoint_every;
   options.threads_from_work = args.threads <= 0;  // --threads fixes the count; otherwise it follows the work
-  ProgressPrinter progress(stdout, args.quiet);
+  // Distributed, the root rank speaks for the run; an error every rank meets (the scene's, a watchdog stop) is
+  // printed once, by the root, and any other by the rank that met it.
+  const par::Comm& comm = par::Comm::world();
+  ProgressPrinter progress(stdout, args.quiet || !comm.root());
   try {
     scene::with_dimension(s, [&](auto dim) {
       constexpr int D = decltype(dim)::value;
@@ -293,10 +300,19 @@ int run_command(const RunArguments& args) {
     });
   } catch (const scene::SceneError& e) {
     progress.done();
+    if (!comm.root()) return kExitUsage;
     return scene_error(e);
+  } catch (const scene::RunFailure& e) {
+    progress.done();
+    if (comm.root()) std::fprintf(stderr, "error: %s\n", e.what());
+    return kExitFailure;
   } catch (const std::exception& e) {
     progress.done();
-    std::fprintf(stderr, "error: %s\n", e.what());
+    if (comm.distributed()) {
+      std::fprintf(stderr, "error (rank %d): %s\n", comm.rank(), e.what());
+    } else {
+      std::fprintf(stderr, "error: %s\n", e.what());
+    }
     return kExitFailure;
   }
   return 0;
@@ -334,6 +350,9 @@ int info_command() {
   std::printf("  HDF5        %u.%u.%u\n", h5_major, h5_minor, h5_release);
   std::printf("  nlohmann    %d.%d.%d\n", NLOHMANN_JSON_VERSION_MAJOR, NLOHMANN_JSON_VERSION_MINOR, NLOHMANN_JSON_VERSION_PATCH);
   std::printf("  CLI11       %s\n", CLI11_VERSION);
+  std::printf("  MPI         %s\n", par::Session::built_with_mpi()
+                                       ? "built with MPI and Zoltan: mpirun -np N sphrefine run SCENE runs across N ranks"
+                                       : "not built with it (one process; the mpi preset builds it)");
   return 0;
 }
 

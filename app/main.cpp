@@ -4,15 +4,20 @@
 //   sphrefine validate SCENE [--set key.path=value ...]
 //   sphrefine info
 //   sphrefine keys [--markdown | --sync FILE | --check FILE]
+// Built with the mpi preset, `mpirun -np N sphrefine run SCENE` runs the scene across N ranks (issue #19).
 #include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <optional>
 
 #include "app/commands.hpp"
 #include "app/wait_policy.hpp"
 #include "core/allocator_tuning.hpp"
+#include "parallel/comm.hpp"
 
-int main(int argc, char** argv) {
-  sph::app::ensure_wait_policy(argv);  // may start the program again, before anything else happens
-  sph::tune_allocator();
+namespace {
+
+int program(int argc, char** argv) {
   CLI::App app{"sphrefine: weakly-compressible SPH with dynamic particle refinement"};
   app.require_subcommand(1);
 
@@ -66,4 +71,22 @@ int main(int argc, char** argv) {
     return sph::app::keys_command(keys);
   }
   return sph::app::kExitUsage;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  sph::app::ensure_wait_policy(argv);  // may start the program again, before anything else happens
+  sph::tune_allocator();
+  std::optional<sph::par::Session> mpi;
+  try {
+    mpi.emplace(argc, argv);  // MPI only when an MPI launcher started this process
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return sph::app::kExitUsage;
+  }
+  const int code = program(argc, argv);
+  // A rank that stops with an error takes the others down with it (they may be waiting for it), with its code.
+  if (code != 0 && sph::par::Comm::world().distributed()) sph::par::Session::abort(code);
+  return code;
 }

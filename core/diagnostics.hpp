@@ -12,6 +12,7 @@
 
 #include "core/equation_of_state.hpp"
 #include "core/particle_store.hpp"
+#include "parallel/comm.hpp"
 #include "parallel/exact_sum.hpp"
 #include "parallel/parallel_for.hpp"
 
@@ -63,9 +64,13 @@ struct DiagnosticsT {
 };
 using Diagnostics = DiagnosticsT<2>;
 
+/// The diagnostics of the store's fluid. With `comm` (a distributed run, core/domain.hpp) of every rank's own fluid:
+/// the exact sums are merged exactly, so the result has the same bits at any rank count; halos are never counted,
+/// wall particles (which every rank holds) once, and ghosts as `own_ghosts` (this rank's own fluid's).
 template <int D>
 DiagnosticsT<D> compute_diagnostics(const ParticleStore<D>& store, const TaitEquationOfState& eos,
-                                    const Vec<D>& gravity) {
+                                    const Vec<D>& gravity, const par::Comm* comm = nullptr,
+                                    std::size_t own_ghosts = 0) {
   // Every sum is exact, rounded once (par::ExactSum): the diagnostics are the same bits whatever the store's order
   // and however its particles are split between threads or, in a distributed run, between ranks.
   struct Acc {
@@ -83,6 +88,7 @@ DiagnosticsT<D> compute_diagnostics(const ParticleStore<D>& store, const TaitEqu
   const Acc acc = par::accumulate(
       store.size(), Acc{},
       [&](Acc& a, std::size_t i) {
+        if (kind[i] == Kind::halo) return;
         if (kind[i] == Kind::ghost) {
           ++a.ghosts;
           return;
@@ -121,28 +127,49 @@ DiagnosticsT<D> compute_diagnostics(const ParticleStore<D>& store, const TaitEqu
         a.walls += b.walls;
         return a;
       });
-  DiagnosticsT<D> d;
-  d.mass = acc.mass.value();
-  d.kinetic = acc.ke.value();
-  d.potential = acc.pe.value();
-  d.elastic = acc.el.value();
-  for (int k = 0; k < D; ++k) d.momentum[k] = acc.P[static_cast<std::size_t>(k)].value();
-  if constexpr (D == 2) {
-    d.angular_momentum = acc.L[0].value();
-  } else {
-    for (int k = 0; k < 3; ++k) d.angular_momentum[k] = acc.L[static_cast<std::size_t>(k)].value();
-  }
-  d.max_speed = acc.vmax;
-  d.max_density_error = acc.derr;
-  d.fluid = acc.fluid;
-  d.ghosts = acc.ghosts;
-  d.walls = acc.walls;
+  Acc all = acc;
+  constexpr std::size_t kLevelSlots = 32;
+  std::array<std::uint64_t, kLevelSlots> levels{};
   for (std::size_t i = 0; i < store.size(); ++i) {
     if (kind[i] != Kind::fluid) continue;
-    const auto l = static_cast<std::size_t>(std::max(0, store.level[i]));
-    if (d.per_level.size() <= l) d.per_level.resize(l + 1, 0);
-    ++d.per_level[l];
+    ++levels[std::min(kLevelSlots - 1, static_cast<std::size_t>(std::max(0, store.level[i])))];
   }
+  if (comm != nullptr && comm->distributed()) {
+    all.mass = comm->sum(acc.mass);
+    all.ke = comm->sum(acc.ke);
+    all.pe = comm->sum(acc.pe);
+    all.el = comm->sum(acc.el);
+    for (std::size_t k = 0; k < all.P.size(); ++k) all.P[k] = comm->sum(acc.P[k]);
+    for (std::size_t k = 0; k < all.L.size(); ++k) all.L[k] = comm->sum(acc.L[k]);
+    all.vmax = comm->max(acc.vmax);
+    all.derr = comm->max(acc.derr);
+    all.fluid = comm->sum(std::uint64_t{acc.fluid});
+    all.ghosts = comm->sum(std::uint64_t{own_ghosts});
+    all.walls = acc.walls;  // every rank holds them all
+    const auto per_rank = comm->all_gather_value(levels);
+    levels = {};
+    for (const auto& r : per_rank)
+      for (std::size_t l = 0; l < kLevelSlots; ++l) levels[l] += r[l];
+  }
+  DiagnosticsT<D> d;
+  d.mass = all.mass.value();
+  d.kinetic = all.ke.value();
+  d.potential = all.pe.value();
+  d.elastic = all.el.value();
+  for (int k = 0; k < D; ++k) d.momentum[k] = all.P[static_cast<std::size_t>(k)].value();
+  if constexpr (D == 2) {
+    d.angular_momentum = all.L[0].value();
+  } else {
+    for (int k = 0; k < 3; ++k) d.angular_momentum[k] = all.L[static_cast<std::size_t>(k)].value();
+  }
+  d.max_speed = all.vmax;
+  d.max_density_error = all.derr;
+  d.fluid = all.fluid;
+  d.ghosts = all.ghosts;
+  d.walls = all.walls;
+  for (std::size_t l = 0; l < kLevelSlots; ++l)
+    if (levels[l] > 0) d.per_level.resize(l + 1, 0);
+  for (std::size_t l = 0; l < d.per_level.size(); ++l) d.per_level[l] = levels[l];
   return d;
 }
 

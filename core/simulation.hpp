@@ -22,6 +22,7 @@
 #include "core/boundary/outflow.hpp"
 #include "core/cell_grid.hpp"
 #include "core/diagnostics.hpp"
+#include "core/domain.hpp"
 #include "core/integrator.hpp"
 #include "core/neighbour_cells.hpp"
 #include "core/particle_store.hpp"
@@ -123,6 +124,24 @@ class SimulationT {
   const SweepLimits& last_limits() const { return limits_; }
   const char* sweep_name() const { return sweep_->name(); }
 
+  /// Runs across the ranks of `comm` (issue #19, core/domain.hpp). Every rank must hold the same particles, the
+  /// whole set (the set-up, or a checkpoint every rank read): the cells are cut between the ranks, each keeps its
+  /// own fluid (and every wall particle) with its rates as they are, and the neighbours are rebuilt with the halos.
+  /// Collective. With one rank nothing changes.
+  void distribute(const par::Comm& comm);
+  /// The decomposition when the run is distributed (nullptr in one process).
+  const DomainT<D>* domain() const { return domain_.get(); }
+  const par::Comm& comm() const { return domain_ ? domain_->comm() : par::Comm::world(); }
+  /// Recuts the cells when the ranks' loads (force evaluations per step: max / mean) pass `threshold` and are worse
+  /// than the last recut left them; the particles move to their new owners at the next step's exchange, with their
+  /// rates, so the run's results do not change. Returns the recut, or nothing. Collective. Call it before a step:
+  /// until that step's exchange, the store is laid out by the old cut.
+  std::optional<RebalanceRecord> rebalance(double threshold);
+  /// What the exchanges moved so far on this rank (halo copies, migrations, bytes).
+  const ExchangeCounts& exchanged() const { return exchanged_; }
+  /// Ghosts of this rank's own fluid in the current store (as one process would count them).
+  std::size_t own_ghosts() const { return own_ghosts_; }
+
   /// Drops ghost particles from the store (for output and checkpoints); refresh() brings them back.
   void remove_ghosts() { Ghosts::remove(store_); }
 
@@ -133,6 +152,11 @@ class SimulationT {
 
  private:
   double next_dt() const;
+  /// The step's limits over every rank (the same on all); the limits as they are in one process.
+  SweepLimits global(const SweepLimits& lim) const;
+  /// Distributed: the halos exchanged, then each particle's output count and the smoothing-length range over
+  /// every rank; then build_neighbours.
+  void exchange_and_build();
   /// The activity of substep k, with its due_prefix filled when only some bins are due.
   Activity activity(int k, int finest);
   /// Adds a finished step's work (finest bin, summed limits of its sweeps) to work_.
@@ -161,6 +185,10 @@ class SimulationT {
   std::vector<std::uint8_t> expand_layer_;  // each expanded particle's grid layer (its source's level)
   std::vector<Vec<D>> expand_x_;  // the state before the current step (watchdog rollback)
   Work work_;
+  std::unique_ptr<DomainT<D>> domain_;
+  double last_cut_ = 0.0;  // the loads (max / mean) the last recut made
+  ExchangeCounts exchanged_;
+  std::size_t own_ghosts_ = 0;
   double time_ = 0.0;
   std::uint64_t step_ = 0;
   std::uint64_t fine_steps_ = 0;

@@ -4,6 +4,7 @@
 #include "core/simulation.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -32,6 +33,10 @@ std::uint32_t SimulationT<D>::output_count(const ParticleView<D>& view, std::siz
 
 template <int D>
 void SimulationT<D>::prepare_neighbours() {
+  if (domain_) {
+    exchange_and_build();
+    return;
+  }
   const auto view = store_.view();
   expand_offsets_.resize(view.n + 1);
   const SmoothingRange hr = par::accumulate(
@@ -42,6 +47,72 @@ void SimulationT<D>::prepare_neighbours() {
       },
       [](const SmoothingRange& a, const SmoothingRange& b) { return a.merged(b); });
   build_neighbours(hr);
+}
+
+template <int D>
+void SimulationT<D>::exchange_and_build() {
+  const ExchangeCounts c = domain_->exchange(store_);
+  exchanged_.migrated += c.migrated;
+  exchanged_.halos += c.halos;
+  exchanged_.bytes += c.bytes;
+  exchanged_.seconds += c.seconds;
+  const auto view = store_.view();
+  expand_offsets_.resize(view.n + 1);
+  SmoothingRange hr = par::accumulate(
+      view.n, SmoothingRange{},
+      [&](SmoothingRange& r, std::size_t i) {
+        expand_offsets_[i] = output_count(view, i);
+        r.add(view.kind[i], view.h[i], view.level[i]);
+      },
+      [](const SmoothingRange& a, const SmoothingRange& b) { return a.merged(b); });
+  // The layers and their cell sizes come from every rank's fluid, as in one process.
+  for (const SmoothingRange& other : domain_->comm().all_gather_value(hr)) hr = hr.merged(other);
+  build_neighbours(hr);
+}
+
+template <int D>
+SweepLimits SimulationT<D>::global(const SweepLimits& lim) const {
+  if (!domain_) return lim;
+  SweepLimits g;
+  for (const SweepLimits& o : domain_->comm().all_gather_value(lim)) {
+    g = SweepLimits{std::min(g.dt_force, o.dt_force), std::min(g.dt_cfl, o.dt_cfl), g.pairs + o.pairs,
+                    std::max(g.finest_bin, o.finest_bin), g.candidates + o.candidates};
+  }
+  return g;
+}
+
+template <int D>
+void SimulationT<D>::distribute(const par::Comm& comm) {
+  if (!comm.distributed()) return;
+  remove_ghosts();
+  // Decomposition cells as wide as the largest pair support of the set-up, 2 h_max: refinement only makes h smaller.
+  const double reach = 2.0 * comm.max(smoothing_range(store_).max());
+  domain_ = std::make_unique<DomainT<D>>(comm, settings_.geometry.container.lo, settings_.geometry.container.hi,
+                                         reach > 0.0 ? reach : 1.0);
+  domain_->partition(store_, integrator_, true);
+  domain_->exchange(store_, true);
+  // Each particle keeps its rates (the set-up's evaluation, or a checkpoint's: the rates the next step opens with),
+  // and the limits are the whole set's already; only the grid is rebuilt, with the halos.
+  prepare_neighbours();
+}
+
+template <int D>
+std::optional<RebalanceRecord> SimulationT<D>::rebalance(double threshold) {
+  if (!domain_) return std::nullopt;
+  RebalanceRecord r;
+  r.step = step_;
+  r.before = domain_->imbalance(store_, integrator_);
+  // Past the threshold, and worse than the last cut left it (cells are whole: a cut cannot always do better, and
+  // recutting to the same loads every check would only cost).
+  if (!(r.before > threshold) || (last_cut_ > 0.0 && r.before <= last_cut_ + 0.02)) return std::nullopt;
+  const auto start = std::chrono::steady_clock::now();
+  domain_->partition(store_, integrator_, false);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.after = domain_->imbalance(store_, integrator_);
+  last_cut_ = r.after;
+  // The particles move to their new owners at the next step's exchange, with their rates: the results do not
+  // change, and the store between steps (ghosts, halos) stays the one the last step built, as in one process.
+  return r;
 }
 
 template <int D>
@@ -95,6 +166,12 @@ void SimulationT<D>::build_neighbours(const SmoothingRange& hr) {
   const Vec<D> anchor = grid_anchor(settings_.geometry.container);
   neighbour_layers<D>(hr, boxes, spec, &anchor);
   grid_.build_layers(spec.data(), layers, expand_x_.data(), layers > 1 ? expand_layer_.data() : nullptr, m);
+  if (domain_) {  // the ghosts of this rank's own fluid (not of its halos), for the diagnostics' count
+    std::size_t own = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (view.kind[i] == Kind::fluid) own += expand_offsets_[i + 1] - expand_offsets_[i] - 1;
+    own_ghosts_ = own;
+  }
   // Within a cell, by id, and a ghost after its source by image: the order, and so every pair sum, comes from
   // the particles alone, not from the store's order before the sort (core/cell_grid.hpp, order_cells_by).
   const std::uint32_t* src = expand_src_.data();
@@ -123,7 +200,7 @@ void SimulationT<D>::refresh() {
     if (s.kind[i] == Kind::fluid) s.p[i] = eos.pressure(s.rho[i]);
   });
   prepare_neighbours();
-  limits_ = sweep_->run(store_.view(), grid_, integrator_.activity(1, 0));
+  limits_ = global(sweep_->run(store_.view(), grid_, integrator_.activity(1, 0)));
   dt_ = next_dt();
 }
 
@@ -224,21 +301,32 @@ StepInfo SimulationT<D>::step(double dt_cap) {
     }
     // The drift can already have produced a non-finite position, which the grid refuses: with the watchdog on,
     // that is reported (and undone) like any other failure of the step, naming the particle.
+    // Distributed, the ranks agree on whether the substep failed before the next collective call, so that no rank
+    // waits for one that has left the step.
+    SweepLimits lim;
     try {
-      if (renumbered) {
+      if (renumbered || domain_) {
         prepare_neighbours();
       } else {
         build_neighbours(hr);
       }
-      const SweepLimits lim = sweep_->run(store_.view(), grid_, activity(k, finest));
-      step_limits = SweepLimits{std::min(step_limits.dt_force, lim.dt_force),
-                                std::min(step_limits.dt_cfl, lim.dt_cfl), step_limits.pairs + lim.pairs,
-                                lim.finest_bin,  // the last evaluation covers every bin
-                                step_limits.candidates + lim.candidates};
+      lim = sweep_->run(store_.view(), grid_, activity(k, finest));
     } catch (const std::exception& e) {
-      if (!watch) throw;
+      if (!watch && !domain_) throw;
       step_error = e.what();
     }
+    if (domain_ && domain_->comm().any(!step_error.empty()) && step_error.empty()) {
+      step_error = "the step failed on another rank";
+    }
+    if (!step_error.empty()) {
+      if (!watch) throw std::runtime_error(step_error);
+      break;
+    }
+    lim = global(lim);
+    step_limits = SweepLimits{std::min(step_limits.dt_force, lim.dt_force), std::min(step_limits.dt_cfl, lim.dt_cfl),
+                              step_limits.pairs + lim.pairs,
+                              lim.finest_bin,  // the last evaluation covers every bin
+                              step_limits.candidates + lim.candidates};
   }
   if (step_error.empty()) {
     auto s = store_.view();
@@ -250,8 +338,13 @@ StepInfo SimulationT<D>::step(double dt_cap) {
   }
   if (watch) {
     FailureReport report;
-    if (find_failure(store_, settings_.geometry, settings_.eos.rho0, settings_.watchdog, report) || !step_error.empty() ||
-        !(std::isfinite(dt) && dt > 0.0)) {
+    const bool found = find_failure(store_, settings_.geometry, settings_.eos.rho0, settings_.watchdog, report);
+    bool failed = found || !step_error.empty() || !(std::isfinite(dt) && dt > 0.0);
+    if (domain_) {  // every rank rolls back when one fails, and reports the failure of the first rank that found one
+      failed = domain_->comm().any(failed);
+      if (failed) report = first_report(domain_->comm(), found ? &report : nullptr);
+    }
+    if (failed) {
       if (report.quantity.empty() && !step_error.empty()) {
         report.quantity = "the step could not be completed (" + step_error + ")";
         report.cause = "a time step too large for the forces, or an invalid state";
@@ -284,6 +377,7 @@ template <int D>
 void SimulationT<D>::run_stages() {
   bool changed = false;
   for (auto& stage : stages_) changed = stage->after_step(*this) || changed;
+  if (domain_) changed = domain_->comm().any(changed);  // a split on one rank changes the others' halos
   if (changed) refresh();
 }
 
@@ -297,12 +391,18 @@ void SimulationT<D>::run_until(double t_end) {
 
 template <int D>
 DiagnosticsT<D> SimulationT<D>::diagnostics() const {
-  DiagnosticsT<D> d = compute_diagnostics<D>(store_, settings_.eos, settings_.gravity.value_or(Vec<D>::Zero()));
+  DiagnosticsT<D> d = compute_diagnostics<D>(store_, settings_.eos, settings_.gravity.value_or(Vec<D>::Zero()),
+                                             domain_ ? &domain_->comm() : nullptr, own_ghosts_);
   d.time = time_;
   d.step = step_;
   d.dt = dt_;
-  d.removed = removed_.particles;
-  d.removed_mass = removed_.mass.value();
+  if (domain_) {  // each rank removed its own
+    d.removed = domain_->comm().sum(removed_.particles);
+    d.removed_mass = domain_->comm().sum(removed_.mass).value();
+  } else {
+    d.removed = removed_.particles;
+    d.removed_mass = removed_.mass.value();
+  }
   return d;
 }
 

@@ -42,7 +42,10 @@ struct AnyVec : Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 3, 1> 
 
 /// What a particle is: a real fluid particle, a fixed wall particle (Lennard-Jones repulsion, eq. 10),
 /// or a ghost mirrored from a fluid particle across a wall (section 2.4).
-enum class Kind : std::uint8_t { fluid = 0, wall = 1, ghost = 2 };
+/// fluid; wall (a wall particle); ghost (a mirror image of a fluid particle or halo across a wall); halo (a copy of
+/// another rank's fluid particle, core/domain.hpp: a neighbour like fluid, but this rank neither moves it nor
+/// computes its rates, and it is never output).
+enum class Kind : std::uint8_t { fluid = 0, wall = 1, ghost = 2, halo = 3 };
 
 /// How a particle took its level: at set-up, as a daughter of a split, or as the particle a merge made
 /// (`fresh_merge` until the refinement check after that merge, which does not split it, then `merge`).

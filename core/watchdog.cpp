@@ -102,4 +102,39 @@ template bool find_failure<2>(const ParticleStore<2>&, const Geometry<2>&, doubl
 template bool find_failure<3>(const ParticleStore<3>&, const Geometry<3>&, double, const WatchdogSettings&,
                               FailureReport&);
 
+FailureReport first_report(const par::Comm& comm, const FailureReport* mine) {
+  std::vector<std::byte> b;
+  par::put<std::uint8_t>(b, mine != nullptr ? 1 : 0);
+  if (mine != nullptr) {
+    par::put(b, static_cast<int>(mine->kind));
+    par::put(b, mine->step);
+    par::put(b, mine->time);
+    par::put(b, mine->id);
+    par::put<std::uint64_t>(b, static_cast<std::uint64_t>(mine->position.size()));
+    for (Eigen::Index a = 0; a < mine->position.size(); ++a) par::put(b, mine->position[a]);
+    par::put_string(b, mine->quantity);
+    par::put_string(b, mine->cause);
+  }
+  std::vector<std::size_t> from;
+  const std::vector<std::byte> all = comm.all_gather(b, &from);
+  std::size_t at = 0;
+  for (const std::size_t bytes : from) {
+    const std::size_t next = at + bytes;
+    if (par::take<std::uint8_t>(all, at) != 0) {
+      FailureReport r;
+      r.kind = static_cast<FailureKind>(par::take<int>(all, at));
+      r.step = par::take<std::uint64_t>(all, at);
+      r.time = par::take<double>(all, at);
+      r.id = par::take<ParticleId>(all, at);
+      r.position.resize(static_cast<Eigen::Index>(par::take<std::uint64_t>(all, at)));
+      for (Eigen::Index a = 0; a < r.position.size(); ++a) r.position[a] = par::take<double>(all, at);
+      r.quantity = par::take_string(all, at);
+      r.cause = par::take_string(all, at);
+      return r;
+    }
+    at = next;
+  }
+  return {};
+}
+
 }  // namespace sph

@@ -9,6 +9,7 @@
 
 #include "core/boundary/wall.hpp"
 #include "core/particle_store.hpp"
+#include "parallel/comm.hpp"
 
 namespace sph {
 
@@ -48,5 +49,9 @@ class SimulationFailure : public std::runtime_error {
 template <int D>
 bool find_failure(const ParticleStore<D>& store, const Geometry<D>& geometry, double rho0,
                   const WatchdogSettings& settings, FailureReport& out);
+
+/// The report of the lowest rank that found a failure (`mine` when this rank found one, else nullptr), on every rank;
+/// an empty report when none did. Collective.
+FailureReport first_report(const par::Comm& comm, const FailureReport* mine);
 
 }  // namespace sph

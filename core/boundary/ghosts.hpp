@@ -145,7 +145,7 @@ class GhostBuilderT {
   /// How many outputs particle i has in the ghost expansion: old ghosts 0, walls 1, fluid 1 + its images.
   std::uint32_t output_count(const ParticleView<D>& view, std::size_t i) const {
     if (view.kind[i] == Kind::ghost) return 0;
-    if (view.kind[i] != Kind::fluid) return 1;
+    if (view.kind[i] != Kind::fluid && view.kind[i] != Kind::halo) return 1;  // a halo has its images too
     return 1u + static_cast<std::uint32_t>(images(view.x[i], view.v[i], view.h[i]).count);
   }
 

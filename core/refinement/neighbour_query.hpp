@@ -29,7 +29,8 @@ class NeighbourQueryIn {
     });
   }
 
-  /// Calls f(j, r) for every fluid particle j != i with r_ij < 2 h_ij, in a fixed order.
+  /// Calls f(j, r) for every fluid particle j != i with r_ij < 2 h_ij, in a fixed order; distributed, another rank's
+  /// fluid (a halo) is a fluid neighbour too.
   template <class F>
   void for_each_fluid_neighbour(std::size_t i, F&& f) const {
     const auto& order = grid_.order();
@@ -38,7 +39,7 @@ class NeighbourQueryIn {
     grid_.for_each_support_run(xi, hi, [&](std::uint32_t b, std::uint32_t e) {
       for (std::uint32_t k = b; k < e; ++k) {
         const std::uint32_t j = order[k];
-        if (j == i || store_.kind[j] != Kind::fluid) continue;
+        if (j == i || (store_.kind[j] != Kind::fluid && store_.kind[j] != Kind::halo)) continue;
         const double r2 = (xi - store_.x[j]).squaredNorm();
         const double support = hi + store_.h[j];
         if (r2 < support * support) f(static_cast<std::size_t>(j), std::sqrt(r2));

@@ -6,6 +6,8 @@
 #include <vector>
 #include <limits>
 
+#include <cstring>
+
 #include "core/kernel.hpp"
 
 namespace sph::scene {
@@ -46,7 +48,7 @@ double layered_top(std::vector<std::pair<double, double>>& v, double gap, double
 /// air cavity is measured at its crest, as a wave gauge sees it, while a few isolated splash particles above the
 /// surface are not.
 template <int D>
-double column_top(const ParticleStore<D>& store, const Horizontal<D>& at, double band, double gap) {
+std::vector<std::pair<double, double>> column(const ParticleStore<D>& store, const Horizontal<D>& at, double band) {
   std::vector<std::pair<double, double>> v;
   for (std::size_t i = 0; i < store.size(); ++i) {
     if (store.kind[i] != Kind::fluid) continue;
@@ -55,6 +57,33 @@ double column_top(const ParticleStore<D>& store, const Horizontal<D>& at, double
     if (!inside) continue;
     v.emplace_back(store.x[i][D - 1], 0.5 * store.d[i]);
   }
+  return v;
+}
+
+template <int D>
+std::vector<std::pair<double, double>> front_edges(const ParticleStore<D>& store) {
+  std::vector<std::pair<double, double>> xs;
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    if (store.kind[i] == Kind::fluid) xs.emplace_back(store.x[i][0], 0.5 * store.d[i]);
+  }
+  return xs;
+}
+
+/// Every rank's pairs (each rank's own fluid), on every rank; the pairs as they are in one process.
+std::vector<std::pair<double, double>> everyones(const par::Comm* comm, std::vector<std::pair<double, double>> v) {
+  if (comm == nullptr || !comm->distributed()) return v;
+  std::vector<std::byte> mine(v.size() * sizeof(v[0]));
+  if (!v.empty()) std::memcpy(mine.data(), v.data(), mine.size());
+  const std::vector<std::byte> all = comm->all_gather(mine);
+  std::vector<std::pair<double, double>> out(all.size() / sizeof(v[0]));
+  if (!out.empty()) std::memcpy(static_cast<void*>(out.data()), all.data(), all.size());
+  return out;
+}
+
+template <int D>
+double column_top(const ParticleStore<D>& store, const Horizontal<D>& at, double band, double gap,
+                  const par::Comm* comm = nullptr) {
+  std::vector<std::pair<double, double>> v = everyones(comm, column<D>(store, at, band));
   return layered_top(v, gap, 2.0 * gap);
 }
 
@@ -72,10 +101,7 @@ double water_height(const ParticleStore<2>& store, double x, double band, double
 
 template <int D>
 double surge_front(const ParticleStore<D>& store, double origin, double gap) {
-  std::vector<std::pair<double, double>> xs;
-  for (std::size_t i = 0; i < store.size(); ++i) {
-    if (store.kind[i] == Kind::fluid) xs.emplace_back(store.x[i][0], 0.5 * store.d[i]);
-  }
+  std::vector<std::pair<double, double>> xs = front_edges<D>(store);
   const double front = layered_top(xs, gap, std::numeric_limits<double>::infinity());
   return std::isfinite(front) ? front - origin : 0.0;
 }
@@ -112,21 +138,39 @@ Probes::Probes(const Scene& scene) {
 }
 
 template <int D>
-std::vector<double> Probes::measure(const ParticleStore<D>& store) const {
+std::vector<double> Probes::measure(const ParticleStore<D>& store, const DomainT<D>* domain) const {
+  const par::Comm* comm = domain != nullptr ? &domain->comm() : nullptr;
   std::vector<double> out;
   out.reserve(probes_.size());
   for (const Resolved& p : probes_) {
     switch (p.kind) {
-      case ProbeKind::water_height:
-        out.push_back(water_height<D>(store, Horizontal<D>(p.at.data()), p.band, p.reference, gap_));
+      case ProbeKind::water_height: {
+        const double top = column_top<D>(store, Horizontal<D>(p.at.data()), p.band, gap_, comm);
+        out.push_back(std::isfinite(top) ? top - p.reference : 0.0);
         break;
+      }
       case ProbeKind::surface_elevation: {
-        const double top = column_top<D>(store, Horizontal<D>(p.at.data()), p.band, gap_);
+        const double top = column_top<D>(store, Horizontal<D>(p.at.data()), p.band, gap_, comm);
         out.push_back(std::isfinite(top) ? top - p.reference : std::numeric_limits<double>::quiet_NaN());
         break;
       }
-      case ProbeKind::surge_front: out.push_back(surge_front<D>(store, p.reference, gap_)); break;
-      case ProbeKind::pressure: out.push_back(point_pressure<D>(store, p.position.fixed<D>())); break;
+      case ProbeKind::surge_front: {
+        std::vector<std::pair<double, double>> xs = everyones(comm, front_edges<D>(store));
+        const double front = layered_top(xs, gap_, std::numeric_limits<double>::infinity());
+        out.push_back(std::isfinite(front) ? front - p.reference : 0.0);
+        break;
+      }
+      case ProbeKind::pressure: {
+        // Distributed: the rank owning the point's cell holds every particle within reach of it (its own fluid, its
+        // halos and their ghosts), in the same relative order as one process's store (cells on the anchored
+        // lattice, each in id order), so its sum is the one-process sum; the others' values are not used.
+        const Vec<D> at = p.position.fixed<D>();
+        const double mine = point_pressure<D>(store, at);
+        out.push_back(comm == nullptr || !comm->distributed()
+                          ? mine
+                          : comm->all_gather_value(mine)[static_cast<std::size_t>(domain->owner_of(at))]);
+        break;
+      }
     }
   }
   return out;
@@ -136,8 +180,8 @@ template double water_height<2>(const ParticleStore<2>&, const Horizontal<2>&, d
 template double water_height<3>(const ParticleStore<3>&, const Horizontal<3>&, double, double, double);
 template double surge_front<2>(const ParticleStore<2>&, double, double);
 template double surge_front<3>(const ParticleStore<3>&, double, double);
-template std::vector<double> Probes::measure<2>(const ParticleStore<2>&) const;
-template std::vector<double> Probes::measure<3>(const ParticleStore<3>&) const;
+template std::vector<double> Probes::measure<2>(const ParticleStore<2>&, const DomainT<2>*) const;
+template std::vector<double> Probes::measure<3>(const ParticleStore<3>&, const DomainT<3>*) const;
 template double point_pressure<2>(const ParticleStore<2>&, const Vec<2>&);
 template double point_pressure<3>(const ParticleStore<3>&, const Vec<3>&);
 

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "core/domain.hpp"
 #include "core/particle_store.hpp"
 #include "core/scene/scene.hpp"
 
@@ -42,9 +43,10 @@ class Probes {
  public:
   explicit Probes(const Scene& scene);
   const std::vector<std::string>& names() const { return names_; }
-  /// One value per probe, in scene order (D the scene's dimension).
+  /// One value per probe, in scene order (D the scene's dimension). Distributed (`domain`), collective: every
+  /// rank gets the values of the whole fluid, with the same bits as in one process.
   template <int D>
-  std::vector<double> measure(const ParticleStore<D>& store) const;
+  std::vector<double> measure(const ParticleStore<D>& store, const DomainT<D>* domain = nullptr) const;
 
  private:
   struct Resolved {

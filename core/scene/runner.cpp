@@ -13,6 +13,7 @@
 #include "core/io/time_series.hpp"
 #include "core/scene/scene_builder.hpp"
 #include "core/scene/scene_parser.hpp"
+#include "parallel/comm.hpp"
 #include "parallel/threads.hpp"
 
 namespace sph::scene {
@@ -44,6 +45,30 @@ Json physics_of(const Scene& s) {
   for (const char* key : {"name", "description", "time", "probes", "output"}) j.erase(key);
   j["container"].erase("outflow");
   return j;
+}
+
+/// Distributed runs (issue #19): the loads are compared every this many steps, and the cells recut when the most
+/// loaded rank carries more than this times the mean (force evaluations per step).
+constexpr std::uint64_t kRebalanceEvery = 50;
+constexpr double kRebalanceAbove = 1.10;
+
+/// On the root rank, every rank's own fluid and the root's wall particles in one store (the particles of one
+/// process's store, ghosts aside); empty elsewhere. Collective.
+template <int D>
+ParticleStore<D> gathered(const SimulationT<D>& sim) {
+  const par::Comm& comm = sim.comm();
+  const ParticleStore<D>& store = sim.store();
+  std::vector<std::byte> mine;
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    if (store.kind[i] == Kind::fluid || (comm.root() && store.kind[i] == Kind::wall)) pack_particle(store, i, mine);
+  }
+  ParticleStore<D> all;
+  const std::vector<std::byte> bytes = comm.gather(mine, 0);
+  if (comm.root()) {
+    all.set_next_id(store.next_id());
+    unpack_particles(all, bytes);
+  }
+  return all;
 }
 
 }  // namespace
@@ -87,10 +112,20 @@ RunnerT<D>::RunnerT(Scene scene, RunOptions options)
     RemovedFluid removed;
     removed.particles = state.removed_particles;
     for (double part : state.removed_mass_parts) removed.mass.add(part);
-    sim_.set_removed(removed);
+    // Distributed, each rank counts what it removes, and the root carries what was removed before.
+    if (par::Comm::world().root()) sim_.set_removed(removed);
     last_row_step_ = last_frame_step_ = last_checkpoint_step_ = state.step;
     resumed_ = true;
-  } else {
+  }
+  if (par::Comm::world().distributed()) {
+    if (scene_.effects.refinement && scene_.effects.refinement->coarsening) {
+      throw SceneError("effects.refinement.coarsening",
+                       "coarsening does not run across ranks yet (issue #19): run this scene in one process, or "
+                       "without coarsening (splits alone do run across ranks)");
+    }
+    sim_.distribute(par::Comm::world());  // every rank built (or read) the whole set: each keeps its share
+  }
+  if (!resumed_) {
     const DiagnosticsT<D> d = sim_.diagnostics();
     initial_mass_ = d.mass;
     initial_momentum_ = d.momentum;
@@ -146,6 +181,10 @@ void RunnerT<D>::start() {
   started_ = true;
   wall_start_ = now_seconds();
   if (options_.folder.empty()) return;
+  if (!sim_.comm().root()) {  // distributed: the root writes; the others take part in the collective outputs
+    if (!resumed_) write_due_outputs(false);
+    return;
+  }
   std::filesystem::create_directories(options_.folder);
   if (scene_.output.frames) std::filesystem::create_directories(files_.frames());
   if (resumed_) {
@@ -172,6 +211,12 @@ void RunnerT<D>::start() {
 template <int D>
 void RunnerT<D>::advance() {
   if (!started_) start();
+  // Distributed: a recut before the step, whose exchange then moves the particles to their new owners.
+  if (sim_.comm().distributed() && sim_.step_count() > 0 && sim_.step_count() % kRebalanceEvery == 0 &&
+      sim_.step_count() != last_recut_check_) {
+    last_recut_check_ = sim_.step_count();
+    if (const auto r = sim_.rebalance(kRebalanceAbove)) rebalances_.push_back(*r);
+  }
   const double t0 = sim_.time();
   const double remaining = scene_.time.end - t0;
   if (sim_.dt() > remaining && options_.checkpoint_interval) {
@@ -202,7 +247,8 @@ void RunnerT<D>::advance() {
   const std::size_t fluid = fluid_count();
   if (fluid != last_fluid_) fit_threads(fluid);
   last_fluid_ = fluid;
-  particle_steps_ += last_fluid_;
+  last_fluid_total_ = sim_.comm().distributed() ? sim_.comm().sum(std::uint64_t{fluid}) : fluid;
+  particle_steps_ += last_fluid_total_;
   write_due_outputs(false);
 }
 
@@ -248,8 +294,8 @@ void RunnerT<D>::write_row() {
   for (const double v : {d.kinetic, d.potential, d.elastic, d.total_energy(), d.max_speed, d.max_density_error}) {
     row.push_back(v);
   }
-  for (const double v : probes_.measure(sim_.store())) row.push_back(v);
-  series_->write(row);
+  for (const double v : probes_.measure(sim_.store(), sim_.domain())) row.push_back(v);
+  if (series_) series_->write(row);
   last_row_step_ = d.step;
   ++rows_;
 }
@@ -257,10 +303,20 @@ void RunnerT<D>::write_row() {
 template <int D>
 void RunnerT<D>::write_frame() {
   const std::uint64_t index = frame_count_;
-  const io::FrameHeader h = io::write_frame(files_.frame(index), io::RunFiles::frame_group(index), sim_.store(),
-                                            sim_.time(), sim_.step_count(), index, scene_.output.fields);
-  frames_.push_back({"frames/" + io::RunFiles::frame_file_name(index), h});
-  io::write_xdmf(files_.xdmf(), frames_);
+  if (sim_.comm().distributed()) {
+    const ParticleStore<D> all = gathered(sim_);
+    if (sim_.comm().root()) {
+      const io::FrameHeader h = io::write_frame(files_.frame(index), io::RunFiles::frame_group(index), all,
+                                                sim_.time(), sim_.step_count(), index, scene_.output.fields);
+      frames_.push_back({"frames/" + io::RunFiles::frame_file_name(index), h});
+      io::write_xdmf(files_.xdmf(), frames_);
+    }
+  } else {
+    const io::FrameHeader h = io::write_frame(files_.frame(index), io::RunFiles::frame_group(index), sim_.store(),
+                                              sim_.time(), sim_.step_count(), index, scene_.output.fields);
+    frames_.push_back({"frames/" + io::RunFiles::frame_file_name(index), h});
+    io::write_xdmf(files_.xdmf(), frames_);
+  }
   frame_count_ = index + 1;  // file numbering is dense: frame k is the k-th written; its time is an attribute
   last_frame_step_ = sim_.step_count();
   ++frames_written_;
@@ -283,10 +339,18 @@ void RunnerT<D>::write_checkpoint() {
   s.initial_momentum_x = initial_momentum_[0];
   s.initial_momentum_y = initial_momentum_[1];
   if constexpr (D == 3) s.initial_momentum_z = initial_momentum_[2];
-  s.removed_particles = sim_.removed().particles;
-  s.removed_mass_parts = sim_.removed().mass.parts();
   s.scene = scene_to_json(scene_).dump();
-  io::write_checkpoint(files_.checkpoint(), sim_.store(), s);
+  if (sim_.comm().distributed()) {  // one file, the same at any rank count: it resumes at any other
+    const par::Comm& comm = sim_.comm();
+    s.removed_particles = comm.sum(sim_.removed().particles);
+    s.removed_mass_parts = comm.sum(sim_.removed().mass).parts();
+    const ParticleStore<D> all = gathered(sim_);
+    if (comm.root()) io::write_checkpoint(files_.checkpoint(), all, s);
+  } else {
+    s.removed_particles = sim_.removed().particles;
+    s.removed_mass_parts = sim_.removed().mass.parts();
+    io::write_checkpoint(files_.checkpoint(), sim_.store(), s);
+  }
   last_checkpoint_step_ = s.step;
   ++checkpoints_;
 }
@@ -311,12 +375,36 @@ typename RunnerT<D>::Summary RunnerT<D>::summary() const {
 
 template <int D>
 void RunnerT<D>::write_summary(const Summary& r, const FailureReport* failure) {
-  if (options_.folder.empty()) return;
+  // Distributed: the work is every rank's (collective), and the root writes.
+  const par::Comm& comm = sim_.comm();
+  Work w = sim_.work();
+  if (comm.distributed()) {
+    for (auto& e : w.evaluations) e = comm.sum(e);
+    w.pairs = comm.sum(w.pairs);
+    w.candidates = comm.sum(w.candidates);
+  }
+  const std::uint64_t migrated = comm.sum(sim_.exchanged().migrated), halos = comm.sum(sim_.exchanged().halos),
+                      bytes = comm.sum(sim_.exchanged().bytes);
+  const double exchange_seconds = comm.max(sim_.exchanged().seconds);
+  if (options_.folder.empty() || !comm.root()) return;
   Json j;
   j["scene"] = scene_.name;
   j["version"] = SPH_VERSION;
   j["build_type"] = SPH_BUILD_TYPE;
   j["threads"] = omp_get_max_threads();
+  j["ranks"] = comm.size();
+  if (comm.distributed()) {
+    // Every rank's exchanges: particles that changed rank, halo copies, bytes sent, and the most time one rank spent
+    // in them (waiting for the others included); the recuts with the loads before and after (max / mean).
+    Json recuts = Json::array();
+    for (const RebalanceRecord& rb : rebalances_) {
+      recuts.push_back({{"step", rb.step}, {"imbalance_before", rb.before}, {"imbalance_after", rb.after},
+                        {"seconds", rb.seconds}});
+    }
+    j["exchange"] = {{"migrated", migrated},          {"halo_copies", halos},
+                     {"bytes_sent", bytes},           {"seconds_most", exchange_seconds},
+                     {"rebalance_threshold", kRebalanceAbove}, {"rebalances", recuts}};
+  }
   j["threads_rule"] = thread_limit_ > 0 ? "one per " + std::to_string(par::kMinItemsPerThread) +
                                               " fluid particles, at most " + std::to_string(thread_limit_)
                                         : std::string("as set");
@@ -335,7 +423,6 @@ void RunnerT<D>::write_summary(const Summary& r, const FailureReport* failure) {
   // interactions, neighbour candidates checked, and sweeps (substeps). With time.stepping = "global" a step is
   // one sweep of every particle.
   {
-    const Work& w = sim_.work();
     std::size_t levels = 1;
     for (std::size_t l = 0; l < w.evaluations.size(); ++l)
       if (w.evaluations[l] > 0) levels = l + 1;
@@ -370,7 +457,13 @@ void RunnerT<D>::write_summary(const Summary& r, const FailureReport* failure) {
 template <int D>
 void RunnerT<D>::fail(const FailureReport& report) {
   std::string where;
-  if (!options_.folder.empty()) {
+  if (!options_.folder.empty() && !sim_.comm().root()) {  // the collective part of the outputs below
+    const std::uint64_t step = sim_.step_count();
+    if (last_row_step_ != step) write_row();
+    if (scene_.output.frames && last_frame_step_ != step) write_frame();
+    write_checkpoint();
+    write_summary(summary(), &report);
+  } else if (!options_.folder.empty()) {
     // The simulation holds the last good state: leave it behind, complete, for inspection and --resume.
     const std::uint64_t step = sim_.step_count();
     if (last_row_step_ != step) write_row();
@@ -404,7 +497,7 @@ typename RunnerT<D>::Summary RunnerT<D>::run(const std::function<void(const Prog
   while (!finished()) {
     advance();
     if (on_step) {
-      on_step(Progress{sim_.time(), scene_.time.end, sim_.step_count(), steps_run_, last_fluid_,
+      on_step(Progress{sim_.time(), scene_.time.end, sim_.step_count(), steps_run_, last_fluid_total_,
                        now_seconds() - wall_start_});
     }
   }

@@ -130,7 +130,10 @@ class RunnerT {
   std::uint64_t next_row_ = 0, next_frame_ = 0, frame_count_ = 0, next_checkpoint_ = 1;
   std::uint64_t last_row_step_ = UINT64_MAX, last_frame_step_ = UINT64_MAX, last_checkpoint_step_ = UINT64_MAX;
   std::uint64_t particle_steps_ = 0, steps_run_ = 0, rows_ = 0, frames_written_ = 0, checkpoints_ = 0;
-  std::size_t last_fluid_ = 0;  // fluid particles after the last step
+  std::vector<RebalanceRecord> rebalances_;  // distributed: the recuts of the cells
+  std::uint64_t last_recut_check_ = 0;
+  std::size_t last_fluid_ = 0;  // fluid particles after the last step (this rank's own)
+  std::size_t last_fluid_total_ = 0;  // ... on every rank
   int thread_limit_ = 0;        // threads_from_work: the most threads the runner may use
   double initial_mass_ = 0.0;
   Vec<D> initial_momentum_ = Vec<D>::Zero();

@@ -1,0 +1,282 @@
+#pragma once
+// Domain decomposition across ranks (issue #19). Space is cut into decomposition cells on the lattice anchored by
+// the container (grid_anchor), each at least as wide as the largest pair support 2 h_max, so every neighbour of a
+// particle lies in its cell or the 3^D cells around it. Zoltan's RCB (par::Partition) gives every cell an owner
+// from the cells' centres, weighted by their particles' force evaluations per step (2^bin each, so refined levels
+// that step on their own weigh what they cost).
+//
+// A rank's store holds:
+//   - its own fluid: the fluid particles in the cells it owns;
+//   - every wall particle (they never move; the container's wall particles are few against the fluid, O(n^(D-1)/D));
+//   - halos (Kind::halo): copies of the other ranks' fluid particles in the 3^D cells around its own, refreshed
+//     before every force evaluation;
+//   - the ghosts of its own fluid and of its halos (built by the step, as in one process).
+// The pair sweep computes the rates of its own fluid only (a halo is not fluid). Since the grid is on the anchored
+// lattice and each cell's particles are taken in id order, each own particle meets the same neighbours in the same
+// order as in one process, and its rates have the same bits (tests/test_partition.cpp).
+//
+// exchange() is the one collective step: own fluid that left the rank's cells sent to their owner (migration), and
+// the halos rebuilt; the old halos and what left are dropped by the step's own gather. Particles pass through the store's field registry, so every field
+// travels.
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <unordered_map>
+#include <vector>
+
+#include "core/integrator.hpp"
+#include "core/neighbour_cells.hpp"
+#include "core/particle_store.hpp"
+#include "parallel/comm.hpp"
+#include "parallel/partition.hpp"
+
+namespace sph {
+
+/// What one exchange moved (this rank), for the measurements of docs/PERFORMANCE.md.
+struct ExchangeCounts {
+  std::uint64_t migrated = 0;  // own fluid sent to another rank
+  std::uint64_t halos = 0;     // halo copies received
+  std::uint64_t bytes = 0;     // bytes sent
+  double seconds = 0.0;        // wall time in exchange() (packing, messages, unpacking, waiting for the others)
+};
+
+/// One recut of the cells (Simulation::rebalance): the loads before and after (max / mean) and its wall time.
+struct RebalanceRecord {
+  std::uint64_t step = 0;
+  double before = 1.0, after = 1.0, seconds = 0.0;
+};
+
+/// Every field of particle i appended to `out`, in registry order.
+template <int D>
+void pack_particle(const ParticleStore<D>& store, std::size_t i, std::vector<std::byte>& out) {
+  store.for_each_field([&](const auto& f) { par::put(out, f[i]); });
+}
+
+/// Bytes one packed particle takes.
+template <int D>
+std::size_t packed_size() {
+  static const std::size_t n = [] {
+    std::size_t bytes = 0;
+    const ParticleStore<D> empty;
+    empty.for_each_field([&](const auto& f) { bytes += sizeof(typename std::decay_t<decltype(f)>::value_type); });
+    return bytes;
+  }();
+  return n;
+}
+
+/// Appends the packed particles in `bytes` to the store (their ids as packed; the store's next id unchanged);
+/// returns the index of the first.
+template <int D>
+std::size_t unpack_particles(ParticleStore<D>& store, const std::vector<std::byte>& bytes) {
+  const std::size_t record = packed_size<D>();
+  const std::size_t count = bytes.size() / record;
+  const std::size_t first = store.size();
+  store.resize(first + count);
+  std::size_t at = 0;
+  for (std::size_t k = 0; k < count; ++k) {
+    store.for_each_field([&](auto& f) {
+      using T = typename std::decay_t<decltype(f)>::value_type;
+      f[first + k] = par::take<T>(bytes, at);
+    });
+  }
+  return first;
+}
+
+template <int D>
+class DomainT {
+ public:
+  /// `lo`, `hi`: the container; `reach`: the largest pair support the run will see (2 h_max of the set-up).
+  DomainT(const par::Comm& comm, const Vec<D>& lo, const Vec<D>& hi, double reach)
+      : comm_(comm), partition_(comm), edge_(reach * (1.0 + 1e-12)), anchor_(grid_anchor(Box{lo, hi})) {}
+
+  const par::Comm& comm() const { return comm_; }
+  double edge() const { return edge_; }
+
+  /// Cuts the cells between the ranks by the weight of the fluid in them. Collective. With `replicated`, every rank
+  /// holds the same particles (the set-up, a checkpoint read by all) and passes an equal share of the cells.
+  void partition(const ParticleStore<D>& store, const Integrator& integ, bool replicated) {
+    std::unordered_map<std::uint64_t, double> weight;
+    for (std::size_t i = 0; i < store.size(); ++i) {
+      if (store.kind[i] != Kind::fluid) continue;
+      weight[key_of(store.x[i])] += static_cast<double>(1u << integ.bin(store.level[i]));
+    }
+    std::vector<std::uint64_t> keys;
+    keys.reserve(weight.size());
+    for (const auto& [k, w] : weight) keys.push_back(k);
+    std::sort(keys.begin(), keys.end());
+    std::size_t first = 0, last = keys.size();
+    if (replicated) {
+      const auto r = static_cast<std::size_t>(comm_.rank()), p = static_cast<std::size_t>(comm_.size());
+      first = keys.size() * r / p;
+      last = keys.size() * (r + 1) / p;
+    }
+    std::vector<double> coords, weights;
+    for (std::size_t k = first; k < last; ++k) {
+      const Vec<D> c = centre_of(keys[k]);
+      for (int a = 0; a < D; ++a) coords.push_back(c[a]);
+      weights.push_back(weight[keys[k]]);
+    }
+    partition_.cut(D, coords, weights);
+    owner_.clear();
+    targets_.clear();
+  }
+
+  /// The rank owning the cell of x (this rank's for a non-finite position: the watchdog reports it where it is).
+  int owner_of(const Vec<D>& x) const {
+    if (!x.allFinite()) return comm_.rank();
+    return owner_of_key(key_of(x));
+  }
+
+  /// Sends own fluid outside this rank's cells to its owner (with `replicated`, every rank already holds it: it is
+  /// only dropped) and rebuilds the halos, appended to the store; what left and the old halos become ghosts, which
+  /// the step's expansion drops (so build the neighbours right after). Collective.
+  ExchangeCounts exchange(ParticleStore<D>& store, bool replicated = false) {
+    const auto start = std::chrono::steady_clock::now();
+    ExchangeCounts counts;
+    const int me = comm_.rank();
+    const auto ranks = static_cast<std::size_t>(comm_.size());
+    std::vector<std::vector<std::byte>> out(ranks);
+    const std::size_t n = store.size();
+    // What leaves the store (fluid sent away, the old halos) becomes a ghost: the step's expansion, which drops the
+    // ghosts in the gather it does anyway (Simulation::build_neighbours), drops it too, so the exchange needs no
+    // compaction of its own (a gather of every field: it was most of the exchange's time).
+    for (std::size_t i = 0; i < n; ++i) {
+      const Kind k = store.kind[i];
+      if (k == Kind::fluid) {
+        const int o = owner_of(store.x[i]);
+        if (o == me) continue;
+        if (!replicated) {
+          pack_particle(store, i, out[static_cast<std::size_t>(o)]);
+          ++counts.migrated;
+        }
+        store.kind[i] = Kind::ghost;
+      } else if (k == Kind::halo) {
+        store.kind[i] = Kind::ghost;
+      }
+    }
+    for (const auto& b : out) counts.bytes += b.size();
+    unpack_particles(store, comm_.exchange(out));
+    // Halos: each own fluid particle to the owners of the cells around its own (the ones just arrived included).
+    for (auto& b : out) b.clear();
+    for (std::size_t i = 0; i < store.size(); ++i) {
+      if (store.kind[i] != Kind::fluid || !store.x[i].allFinite()) continue;
+      for (const int r : targets_of(key_of(store.x[i]))) pack_particle(store, i, out[static_cast<std::size_t>(r)]);
+    }
+    for (const auto& b : out) counts.bytes += b.size();
+    const std::size_t first = unpack_particles(store, comm_.exchange(out));
+    for (std::size_t i = first; i < store.size(); ++i) store.kind[i] = Kind::halo;
+    counts.halos = store.size() - first;
+    counts.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return counts;
+  }
+
+  /// The loads as the cut assigns the own fluid (each rank's weight by the owner of each particle's cell): max over
+  /// ranks / mean (1: perfectly balanced). Right after an exchange, the ranks' own loads; right after a new cut,
+  /// the loads the next exchange will make. Collective.
+  double imbalance(const ParticleStore<D>& store, const Integrator& integ) const {
+    std::vector<double> w(static_cast<std::size_t>(comm_.size()), 0.0);
+    for (std::size_t i = 0; i < store.size(); ++i) {
+      if (store.kind[i] == Kind::fluid)
+        w[static_cast<std::size_t>(owner_of(store.x[i]))] += static_cast<double>(1u << integ.bin(store.level[i]));
+    }
+    std::vector<double> total(w.size(), 0.0);
+    std::vector<std::byte> mine(w.size() * sizeof(double));
+    std::memcpy(mine.data(), w.data(), mine.size());
+    const std::vector<std::byte> all = comm_.all_gather(mine);
+    for (std::size_t k = 0; k < all.size() / sizeof(double); ++k) {
+      double x = 0.0;
+      std::memcpy(&x, all.data() + k * sizeof(double), sizeof(double));
+      total[k % w.size()] += x;
+    }
+    double sum = 0.0, most = 0.0;
+    for (const double x : total) {
+      sum += x;
+      most = std::max(most, x);
+    }
+    return sum > 0.0 ? most * static_cast<double>(total.size()) / sum : 1.0;
+  }
+
+ private:
+  struct Box {
+    Vec<D> lo, hi;
+  };
+  static constexpr int kBits = D == 2 ? 31 : 21;  // cell coordinate bits per axis
+  static constexpr std::int64_t kMax = (std::int64_t{1} << kBits) - 1;
+
+  std::uint64_t key_of(const Vec<D>& x) const {
+    std::uint64_t key = 0;
+    for (int a = 0; a < D; ++a) {
+      const double c = std::floor((x[a] - anchor_[a]) / edge_);
+      const std::int64_t ic = c < 0.0 ? 0 : (c > static_cast<double>(kMax) ? kMax : static_cast<std::int64_t>(c));
+      key = (key << kBits) | static_cast<std::uint64_t>(ic);
+    }
+    return key;
+  }
+  std::array<std::int64_t, D> coords_of(std::uint64_t key) const {
+    std::array<std::int64_t, D> c{};
+    for (int a = D - 1; a >= 0; --a) {
+      c[static_cast<std::size_t>(a)] = static_cast<std::int64_t>(key & static_cast<std::uint64_t>(kMax));
+      key >>= kBits;
+    }
+    return c;
+  }
+  std::uint64_t key_from(const std::array<std::int64_t, D>& c) const {
+    std::uint64_t key = 0;
+    for (int a = 0; a < D; ++a) key = (key << kBits) | static_cast<std::uint64_t>(c[static_cast<std::size_t>(a)]);
+    return key;
+  }
+  Vec<D> centre_of(std::uint64_t key) const {
+    const std::array<std::int64_t, D> c = coords_of(key);
+    Vec<D> x;
+    for (int a = 0; a < D; ++a) x[a] = anchor_[a] + (static_cast<double>(c[static_cast<std::size_t>(a)]) + 0.5) * edge_;
+    return x;
+  }
+  int owner_of_key(std::uint64_t key) const {
+    const auto it = owner_.find(key);
+    if (it != owner_.end()) return it->second;
+    const Vec<D> c = centre_of(key);
+    std::array<double, D> p{};
+    for (int a = 0; a < D; ++a) p[static_cast<std::size_t>(a)] = c[a];
+    const int o = partition_.owner(p.data());
+    owner_.emplace(key, o);
+    return o;
+  }
+  /// The other ranks owning a cell in the 3^D block around the cell `key` (sorted, each once).
+  const std::vector<int>& targets_of(std::uint64_t key) const {
+    const auto it = targets_.find(key);
+    if (it != targets_.end()) return it->second;
+    std::vector<int> t;
+    const std::array<std::int64_t, D> c = coords_of(key);
+    constexpr int kAround = D == 2 ? 9 : 27;
+    for (int k = 0; k < kAround; ++k) {
+      std::array<std::int64_t, D> b = c;
+      int rest = k;
+      bool inside = true;
+      for (int a = D - 1; a >= 0; --a) {
+        auto& ba = b[static_cast<std::size_t>(a)];
+        ba += rest % 3 - 1;
+        rest /= 3;
+        inside = inside && ba >= 0 && ba <= kMax;
+      }
+      if (!inside) continue;
+      const int o = owner_of_key(key_from(b));
+      if (o != comm_.rank()) t.push_back(o);
+    }
+    std::sort(t.begin(), t.end());
+    t.erase(std::unique(t.begin(), t.end()), t.end());
+    return targets_.emplace(key, std::move(t)).first->second;
+  }
+
+  const par::Comm& comm_;
+  par::Partition partition_;
+  double edge_;
+  Vec<D> anchor_;
+  // Caches of owner_of_key and targets_of (cleared by partition()).
+  mutable std::unordered_map<std::uint64_t, int> owner_;
+  mutable std::unordered_map<std::uint64_t, std::vector<int>> targets_;
+};
+
+}  // namespace sph
