@@ -2,8 +2,9 @@
 """Runs across ranks on this machine (issue #19), measured by whole-process timing of the mpi build's sphrefine.
 
   - The step at 1e6 particles (the paper's dam break at d = 0.025 m: 1e6 fluid particles): 1 rank x 1 thread,
-    1 rank x 2 threads, 2 ranks x 1 thread. A step's time is the difference of two runs of 40 and 20 steps'
-    wall time (run.json) over 20 steps: the set-up, the first outputs and MPI's start-up cancel.
+    1 rank x 2 threads, 2 ranks x 1 thread. A step's time is the difference of two runs' wall time (run.json;
+    end times for about 20 and 40 steps, 28 and 57 in fact) over the steps between: the set-up, the first outputs
+    and MPI's start-up cancel.
   - The share of a step spent in the exchange (halos and migration): run.json's exchange.seconds_most (the most
     one rank spent in exchanges, waiting for the other included) over the run's wall time, same difference.
   - The dynamic dam break (AAP) at 4x the paper's count (3600 particles to start, to t = 4 s): on 2 ranks x 1
