@@ -33,6 +33,13 @@ std::vector<int> displacements(const std::vector<int>& counts) {
   return d;
 }
 
+/// One value reduced over every rank (itself in one process).
+template <class T>
+T reduced(const Comm& c, T x, MPI_Datatype type, MPI_Op op) {
+  if (c.native() != nullptr) check(MPI_Allreduce(MPI_IN_PLACE, &x, 1, type, op, mpi(c)), "allreduce");
+  return x;
+}
+
 int as_count(std::size_t n) {
   if (n > static_cast<std::size_t>(std::numeric_limits<int>::max())) {
     throw std::length_error("MPI: a message of more than 2 GiB (" + std::to_string(n) + " bytes)");
@@ -52,30 +59,31 @@ const Comm& Comm::world() { return the_world(); }
 
 double Comm::min(double x) const {
 #ifdef SPH_MPI
-  if (native_ != nullptr) check(MPI_Allreduce(MPI_IN_PLACE, &x, 1, MPI_DOUBLE, MPI_MIN, mpi(*this)), "allreduce");
-#endif
+  return reduced(*this, x, MPI_DOUBLE, MPI_MIN);
+#else
   return x;
+#endif
 }
 
 double Comm::max(double x) const {
 #ifdef SPH_MPI
-  if (native_ != nullptr) check(MPI_Allreduce(MPI_IN_PLACE, &x, 1, MPI_DOUBLE, MPI_MAX, mpi(*this)), "allreduce");
-#endif
+  return reduced(*this, x, MPI_DOUBLE, MPI_MAX);
+#else
   return x;
+#endif
 }
 
 std::uint64_t Comm::sum(std::uint64_t x) const {
 #ifdef SPH_MPI
-  if (native_ != nullptr) check(MPI_Allreduce(MPI_IN_PLACE, &x, 1, MPI_UINT64_T, MPI_SUM, mpi(*this)), "allreduce");
-#endif
+  return reduced(*this, x, MPI_UINT64_T, MPI_SUM);
+#else
   return x;
+#endif
 }
 
 bool Comm::any(bool x) const {
 #ifdef SPH_MPI
-  int v = x ? 1 : 0;
-  if (native_ != nullptr) check(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_INT, MPI_MAX, mpi(*this)), "allreduce");
-  return v != 0;
+  return reduced(*this, x ? 1 : 0, MPI_INT, MPI_MAX) != 0;
 #else
   return x;
 #endif
