@@ -1,7 +1,17 @@
 # Every dependency comes from Debian (scripts/setup installs them) and is found here, once.
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 find_package(OpenMP REQUIRED COMPONENTS CXX)
-find_package(HDF5 REQUIRED COMPONENTS C CXX)
+if(SPH_MPI)
+  # The mpi preset writes each frame and checkpoint from every rank at once: parallel HDF5 (libhdf5-openmpi-dev), its
+  # C API (the only one the code uses).
+  set(HDF5_PREFER_PARALLEL TRUE)
+  find_package(HDF5 REQUIRED COMPONENTS C)
+  if(NOT HDF5_IS_PARALLEL)
+    message(FATAL_ERROR "the mpi preset needs parallel HDF5: scripts/setup mpi installs libhdf5-openmpi-dev")
+  endif()
+else()
+  find_package(HDF5 REQUIRED COMPONENTS C CXX)
+endif()
 find_package(nlohmann_json 3 REQUIRED)
 find_package(CLI11 REQUIRED)
 if(SPH_BUILD_TESTS)

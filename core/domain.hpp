@@ -85,6 +85,46 @@ std::size_t unpack_particles(ParticleStore<D>& store, const std::vector<std::byt
   return first;
 }
 
+/// The particles a file holds (fluid on every rank, wall particles from the root, which holds them all, as every
+/// rank does), spread over the ranks in id order: rank r gets a contiguous run of ids, all below rank r + 1's, sorted
+/// (a sample sort: each rank's evenly spaced samples of its sorted ids, gathered, give the splitters). Collective;
+/// with one rank, the file's particles of the store in id order.
+template <int D>
+ParticleStore<D> share_in_id_order(const ParticleStore<D>& store, const par::Comm& comm) {
+  std::vector<std::size_t> mine;
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    if (store.kind[i] == Kind::fluid || (comm.root() && store.kind[i] == Kind::wall)) mine.push_back(i);
+  }
+  std::sort(mine.begin(), mine.end(), [&](std::size_t a, std::size_t b) { return store.id[a] < store.id[b]; });
+  const auto ranks = static_cast<std::size_t>(comm.size());
+  // Samples: up to 4 per rank and rank, evenly spaced in this rank's sorted ids.
+  std::vector<ParticleId> samples;
+  const std::size_t per = 4 * ranks;
+  for (std::size_t k = 0; k < per && !mine.empty(); ++k) samples.push_back(store.id[mine[k * mine.size() / per]]);
+  std::vector<std::byte> bytes(samples.size() * sizeof(ParticleId));
+  if (!samples.empty()) std::memcpy(bytes.data(), samples.data(), bytes.size());
+  const std::vector<std::byte> all = comm.all_gather(bytes);
+  std::vector<ParticleId> pool(all.size() / sizeof(ParticleId));
+  if (!pool.empty()) std::memcpy(pool.data(), all.data(), all.size());
+  std::sort(pool.begin(), pool.end());
+  std::vector<ParticleId> splitters;  // rank r takes ids in [splitters[r - 1], splitters[r])
+  for (std::size_t r = 1; r < ranks; ++r) splitters.push_back(pool.empty() ? 0 : pool[r * pool.size() / ranks]);
+  std::vector<std::vector<std::byte>> out(ranks);
+  for (const std::size_t i : mine) {
+    const auto to = static_cast<std::size_t>(std::upper_bound(splitters.begin(), splitters.end(), store.id[i]) -
+                                             splitters.begin());
+    pack_particle(store, i, out[to]);
+  }
+  ParticleStore<D> share;
+  share.set_next_id(store.next_id());
+  unpack_particles(share, comm.exchange(out));
+  std::vector<std::uint32_t> order(share.size());
+  for (std::uint32_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return share.id[a] < share.id[b]; });
+  share.gather(order);
+  return share;
+}
+
 template <int D>
 class DomainT {
  public:

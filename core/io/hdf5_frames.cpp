@@ -3,9 +3,11 @@
 #include <hdf5.h>
 
 #include <algorithm>
+#include <optional>
 #include <stdexcept>
 #include <type_traits>
 
+#include "core/domain.hpp"
 #include "core/io/atomic_file.hpp"
 
 namespace sph::io {
@@ -147,17 +149,86 @@ std::string read_string_attribute(hid_t object, const char* name) {
 
 bool has_attribute(hid_t object, const char* name) { return H5Aexists(object, name) > 0; }
 
-/// One field as a dataset named after it, with its unit as the dataset's `units` attribute.
+/// Which rows of a file this process writes: in one process all of them; across ranks (parallel HDF5), rows
+/// [offset, offset + its count) of `total`, every rank writing its rows of each dataset at once (collectively).
+struct Part {
+  hsize_t total = 0;
+  hsize_t offset = 0;
+  hid_t fapl = kDefault;  // file access: the MPI-IO driver across ranks
+  hid_t dxpl = kDefault;  // transfer: collective across ranks
+  bool shared = false;
+};
+
+/// One field as a dataset named after it, with its unit as the dataset's `units` attribute: this process's rows.
 template <class T>
-void write_dataset(hid_t group, const Field<T>& field, const std::vector<T>& values) {
+void write_dataset(hid_t group, const Field<T>& field, const std::vector<T>& values, const Part& part) {
   using Tr = H5Traits<T>;
   const std::string name(field.name());
-  const hsize_t dims[2] = {values.size(), static_cast<hsize_t>(Tr::components)};
-  const Handle space(H5Screate_simple(Tr::components > 1 ? 2 : 1, dims, nullptr), H5Sclose, "create a dataspace");
+  const int rank = Tr::components > 1 ? 2 : 1;
+  const hsize_t dims[2] = {part.shared ? part.total : values.size(), static_cast<hsize_t>(Tr::components)};
+  const Handle space(H5Screate_simple(rank, dims, nullptr), H5Sclose, "create a dataspace");
   const Handle set(H5Dcreate2(group, name.c_str(), Tr::type(), space, kDefault, kDefault, kDefault), H5Dclose,
                    "create dataset " + name);
-  if (!values.empty()) check(H5Dwrite(set, Tr::type(), H5S_ALL, H5S_ALL, kDefault, values.data()), "write dataset " + name);
+  if (!part.shared) {
+    if (!values.empty()) check(H5Dwrite(set, Tr::type(), H5S_ALL, H5S_ALL, kDefault, values.data()), "write dataset " + name);
+  } else {  // every rank takes part, also with no rows of its own
+    const hsize_t start[2] = {part.offset, 0}, count[2] = {values.size(), static_cast<hsize_t>(Tr::components)};
+    const Handle file_space(H5Dget_space(set), H5Sclose, "get the dataspace of " + name);
+    const Handle memory(H5Screate_simple(rank, count, nullptr), H5Sclose, "create a dataspace");
+    if (values.empty()) {
+      check(H5Sselect_none(file_space), "select no rows of " + name);
+      check(H5Sselect_none(memory), "select no rows");
+    } else {
+      check(H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start, nullptr, count, nullptr), "select rows of " + name);
+    }
+    check(H5Dwrite(set, Tr::type(), memory, file_space, part.dxpl, values.empty() ? nullptr : values.data()),
+          "write dataset " + name);
+  }
   write_string_attribute(set, "units", std::string(field.unit()));
+}
+
+/// The Part of a file of `count` rows from this process: with `comm` across ranks (parallel HDF5), its rows after
+/// the lower ranks' and the MPI-IO property lists, which it owns. Collective.
+class PartLists {
+ public:
+  PartLists(std::size_t count, const par::Comm* comm) {
+    part.total = count;
+    if (comm == nullptr || !comm->distributed()) return;
+#ifdef H5_HAVE_PARALLEL
+    std::uint64_t below = 0, total = 0;
+    const auto counts = comm->all_gather_value(static_cast<std::uint64_t>(count));
+    for (std::size_t r = 0; r < counts.size(); ++r) {
+      if (static_cast<int>(r) < comm->rank()) below += counts[r];
+      total += counts[r];
+    }
+    part.total = total;
+    part.offset = below;
+    part.shared = true;
+    fapl_.emplace(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "create file access properties");
+    check(H5Pset_fapl_mpio(*fapl_, static_cast<MPI_Comm>(comm->native()), MPI_INFO_NULL), "set the MPI-IO driver");
+    dxpl_.emplace(H5Pcreate(H5P_DATASET_XFER), H5Pclose, "create transfer properties");
+    check(H5Pset_dxpl_mpio(*dxpl_, H5FD_MPIO_COLLECTIVE), "set collective transfers");
+    part.fapl = *fapl_;
+    part.dxpl = *dxpl_;
+#else
+    throw std::logic_error("HDF5: a file written across ranks needs parallel HDF5 (the mpi preset links it)");
+#endif
+  }
+  Part part;
+
+ private:
+  std::optional<Handle> fapl_, dxpl_;
+};
+
+/// After every rank closed the file: the root renames it into place, and the others wait for that.
+void commit_part(const std::filesystem::path& file, const par::Comm* comm) {
+  if (comm == nullptr || !comm->distributed()) {
+    commit_file(file);
+    return;
+  }
+  comm->barrier();
+  if (comm->root()) commit_file(file);
+  comm->barrier();
 }
 
 template <class T>
@@ -232,15 +303,20 @@ int group_dimension(hid_t group) {
 
 std::vector<FieldLayout> field_layouts(int dimension) { return dimension == 3 ? layouts_in<3>() : layouts_in<2>(); }
 
+namespace {
+
+/// A frame of the store's fluid and walls in id order: with `comm`, this rank's rows of it (its run of ids).
 template <int D>
-FrameHeader write_frame(const std::filesystem::path& file, const std::string& group, const ParticleStore<D>& store,
-                        double time, std::uint64_t step, std::uint64_t index, const std::vector<std::string>& fields) {
-  quiet_hdf5();
+FrameHeader write_frame_rows(const std::filesystem::path& file, const std::string& group, const ParticleStore<D>& store,
+                             double time, std::uint64_t step, std::uint64_t index,
+                             const std::vector<std::string>& fields, const par::Comm* comm) {
   const std::vector<std::size_t> keep = non_ghosts(store);
-  FrameHeader header{group, time, step, index, keep.size(), {}};
+  const PartLists lists(keep.size(), comm);
+  const Part& part = lists.part;
+  FrameHeader header{group, time, step, index, part.total, {}};
   const std::filesystem::path tmp = temporary_path(file);
   {
-    const Handle f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, kDefault, kDefault), H5Fclose, "create " + tmp.string());
+    const Handle f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, kDefault, part.fapl), H5Fclose, "create " + tmp.string());
     const Handle g(H5Gcreate2(f, group.c_str(), kDefault, kDefault, kDefault), H5Gclose, "create group " + group);
     write_attribute(g, "time", H5T_NATIVE_DOUBLE, time);
     write_string_attribute(g, "time_units", "s");  // step, frame and particles are counts
@@ -250,12 +326,26 @@ FrameHeader write_frame(const std::filesystem::path& file, const std::string& gr
     store.for_each_field([&](const auto& field) {
       if (!wanted(fields, field.name())) return;
       using T = typename std::decay_t<decltype(field)>::value_type;
-      write_dataset(g, field, gathered(field, keep));
+      write_dataset(g, field, gathered(field, keep), part);
       header.fields.push_back(H5Traits<T>::layout(std::string(field.name())));
     });
   }
-  commit_file(file);
+  commit_part(file, comm);
   return header;
+}
+
+}  // namespace
+
+template <int D>
+FrameHeader write_frame(const std::filesystem::path& file, const std::string& group, const ParticleStore<D>& store,
+                        double time, std::uint64_t step, std::uint64_t index, const std::vector<std::string>& fields,
+                        const par::Comm* comm) {
+  quiet_hdf5();
+  if (comm != nullptr && comm->distributed()) {  // each rank writes a run of ids, in id order after the lower ranks'
+    const ParticleStore<D> share = share_in_id_order(store, *comm);
+    return write_frame_rows(file, group, share, time, step, index, fields, comm);
+  }
+  return write_frame_rows(file, group, store, time, step, index, fields, nullptr);
 }
 
 FrameHeader read_frame_header(const std::filesystem::path& file, const std::string& group) {
@@ -287,13 +377,17 @@ std::vector<double> read_frame_field(const std::filesystem::path& file, const st
   return values;
 }
 
+namespace {
+
 template <int D>
-void write_checkpoint(const std::filesystem::path& file, const ParticleStore<D>& store, const CheckpointState& state) {
-  quiet_hdf5();
+void write_checkpoint_rows(const std::filesystem::path& file, const ParticleStore<D>& store, const CheckpointState& state,
+                           const par::Comm* comm) {
   const std::vector<std::size_t> keep = non_ghosts(store);
+  const PartLists lists(keep.size(), comm);
+  const Part& part = lists.part;
   const std::filesystem::path tmp = temporary_path(file);
   {
-    const Handle f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, kDefault, kDefault), H5Fclose, "create " + tmp.string());
+    const Handle f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, kDefault, part.fapl), H5Fclose, "create " + tmp.string());
     const Handle g(H5Gcreate2(f, kCheckpointGroup, kDefault, kDefault, kDefault), H5Gclose, "create the checkpoint group");
     write_attribute(g, "format", H5T_NATIVE_UINT64, kCheckpointFormat);
     write_attribute(g, "time", H5T_NATIVE_DOUBLE, state.time);
@@ -314,11 +408,24 @@ void write_checkpoint(const std::filesystem::path& file, const ParticleStore<D>&
     write_attribute(g, "dimension", H5T_NATIVE_UINT64, static_cast<std::uint64_t>(D));
     write_attribute(g, "removed_particles", H5T_NATIVE_UINT64, state.removed_particles);
     write_double_array_attribute(g, "removed_mass_parts", state.removed_mass_parts);
-    write_attribute(g, "particles", H5T_NATIVE_UINT64, static_cast<std::uint64_t>(keep.size()));
+    write_attribute(g, "particles", H5T_NATIVE_UINT64, static_cast<std::uint64_t>(part.total));
     write_string_attribute(g, "scene", state.scene);
-    store.for_each_field([&](const auto& field) { write_dataset(g, field, gathered(field, keep)); });
+    store.for_each_field([&](const auto& field) { write_dataset(g, field, gathered(field, keep), part); });
   }
-  commit_file(file);
+  commit_part(file, comm);
+}
+
+}  // namespace
+
+template <int D>
+void write_checkpoint(const std::filesystem::path& file, const ParticleStore<D>& store, const CheckpointState& state,
+                      const par::Comm* comm) {
+  quiet_hdf5();
+  if (comm != nullptr && comm->distributed()) {  // as a frame: each rank a run of ids, the file the one-process file
+    write_checkpoint_rows(file, share_in_id_order(store, *comm), state, comm);
+  } else {
+    write_checkpoint_rows(file, store, state, nullptr);
+  }
 }
 
 std::string checkpoint_problem(const std::filesystem::path& file) {
@@ -392,11 +499,13 @@ CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore
 }
 
 template FrameHeader write_frame<2>(const std::filesystem::path&, const std::string&, const ParticleStore<2>&, double,
-                                    std::uint64_t, std::uint64_t, const std::vector<std::string>&);
+                                    std::uint64_t, std::uint64_t, const std::vector<std::string>&, const par::Comm*);
 template FrameHeader write_frame<3>(const std::filesystem::path&, const std::string&, const ParticleStore<3>&, double,
-                                    std::uint64_t, std::uint64_t, const std::vector<std::string>&);
-template void write_checkpoint<2>(const std::filesystem::path&, const ParticleStore<2>&, const CheckpointState&);
-template void write_checkpoint<3>(const std::filesystem::path&, const ParticleStore<3>&, const CheckpointState&);
+                                    std::uint64_t, std::uint64_t, const std::vector<std::string>&, const par::Comm*);
+template void write_checkpoint<2>(const std::filesystem::path&, const ParticleStore<2>&, const CheckpointState&,
+                                  const par::Comm*);
+template void write_checkpoint<3>(const std::filesystem::path&, const ParticleStore<3>&, const CheckpointState&,
+                                  const par::Comm*);
 template CheckpointState read_checkpoint<2>(const std::filesystem::path&, ParticleStore<2>&);
 template CheckpointState read_checkpoint<3>(const std::filesystem::path&, ParticleStore<3>&);
 

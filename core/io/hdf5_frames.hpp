@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/particle_store.hpp"
+#include "parallel/comm.hpp"
 
 namespace sph::io {
 
@@ -37,11 +38,14 @@ struct FrameHeader {
 /// The layout of every field of a D-dimensional store (in registry order).
 std::vector<FieldLayout> field_layouts(int dimension = 2);
 
-/// Writes the named fields (every field when empty; "position" always) of every non-ghost particle to a new
-/// HDF5 file, atomically. Returns what it wrote.
+/// Writes the named fields (every field when empty; "position" always) of every fluid and wall particle to a new
+/// HDF5 file, atomically. Returns what it wrote. With `comm` across ranks (collective): every rank's own fluid and
+/// the wall particles (which every rank holds) once, redistributed so that each rank writes a run of ids, all
+/// ranks at once with parallel HDF5: the file is the one a single process writes.
 template <int D>
 FrameHeader write_frame(const std::filesystem::path& file, const std::string& group, const ParticleStore<D>& store,
-                        double time, std::uint64_t step, std::uint64_t index, const std::vector<std::string>& fields);
+                        double time, std::uint64_t step, std::uint64_t index, const std::vector<std::string>& fields,
+                        const par::Comm* comm = nullptr);
 
 /// The attributes and the datasets of a frame group (its dimension read from the position dataset).
 FrameHeader read_frame_header(const std::filesystem::path& file, const std::string& group);
@@ -72,9 +76,11 @@ struct CheckpointState {
   std::string scene;             // the scene (JSON) the run was started from
 };
 
-/// Writes every field of every non-ghost particle and the state, atomically.
+/// Writes every field of every fluid and wall particle and the state, atomically; with `comm`, collectively as
+/// write_frame (the file is the one-process file, and resumes at any rank count).
 template <int D>
-void write_checkpoint(const std::filesystem::path& file, const ParticleStore<D>& store, const CheckpointState& state);
+void write_checkpoint(const std::filesystem::path& file, const ParticleStore<D>& store, const CheckpointState& state,
+                      const par::Comm* comm = nullptr);
 
 /// Why `file` is not a checkpoint this program reads ("" when it is one: an HDF5 file with the checkpoint
 /// group in the current format). Reads only the file's header.

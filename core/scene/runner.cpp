@@ -52,25 +52,6 @@ Json physics_of(const Scene& s) {
 constexpr std::uint64_t kRebalanceEvery = 50;
 constexpr double kRebalanceAbove = 1.10;
 
-/// On the root rank, every rank's own fluid and the root's wall particles in one store (the particles of one
-/// process's store, ghosts aside); empty elsewhere. Collective.
-template <int D>
-ParticleStore<D> gathered(const SimulationT<D>& sim) {
-  const par::Comm& comm = sim.comm();
-  const ParticleStore<D>& store = sim.store();
-  std::vector<std::byte> mine;
-  for (std::size_t i = 0; i < store.size(); ++i) {
-    if (store.kind[i] == Kind::fluid || (comm.root() && store.kind[i] == Kind::wall)) pack_particle(store, i, mine);
-  }
-  ParticleStore<D> all;
-  const std::vector<std::byte> bytes = comm.gather(mine, 0);
-  if (comm.root()) {
-    all.set_next_id(store.next_id());
-    unpack_particles(all, bytes);
-  }
-  return all;
-}
-
 }  // namespace
 
 template <int D>
@@ -303,17 +284,10 @@ void RunnerT<D>::write_row() {
 template <int D>
 void RunnerT<D>::write_frame() {
   const std::uint64_t index = frame_count_;
-  if (sim_.comm().distributed()) {
-    const ParticleStore<D> all = gathered(sim_);
-    if (sim_.comm().root()) {
-      const io::FrameHeader h = io::write_frame(files_.frame(index), io::RunFiles::frame_group(index), all,
-                                                sim_.time(), sim_.step_count(), index, scene_.output.fields);
-      frames_.push_back({"frames/" + io::RunFiles::frame_file_name(index), h});
-      io::write_xdmf(files_.xdmf(), frames_);
-    }
-  } else {
-    const io::FrameHeader h = io::write_frame(files_.frame(index), io::RunFiles::frame_group(index), sim_.store(),
-                                              sim_.time(), sim_.step_count(), index, scene_.output.fields);
+  // Distributed: every rank writes its rows of the one file (parallel HDF5); the root keeps the XDMF index.
+  const io::FrameHeader h = io::write_frame(files_.frame(index), io::RunFiles::frame_group(index), sim_.store(),
+                                            sim_.time(), sim_.step_count(), index, scene_.output.fields, &sim_.comm());
+  if (sim_.comm().root()) {
     frames_.push_back({"frames/" + io::RunFiles::frame_file_name(index), h});
     io::write_xdmf(files_.xdmf(), frames_);
   }
@@ -340,17 +314,12 @@ void RunnerT<D>::write_checkpoint() {
   s.initial_momentum_y = initial_momentum_[1];
   if constexpr (D == 3) s.initial_momentum_z = initial_momentum_[2];
   s.scene = scene_to_json(scene_).dump();
-  if (sim_.comm().distributed()) {  // one file, the same at any rank count: it resumes at any other
-    const par::Comm& comm = sim_.comm();
-    s.removed_particles = comm.sum(sim_.removed().particles);
-    s.removed_mass_parts = comm.sum(sim_.removed().mass).parts();
-    const ParticleStore<D> all = gathered(sim_);
-    if (comm.root()) io::write_checkpoint(files_.checkpoint(), all, s);
-  } else {
-    s.removed_particles = sim_.removed().particles;
-    s.removed_mass_parts = sim_.removed().mass.parts();
-    io::write_checkpoint(files_.checkpoint(), sim_.store(), s);
-  }
+  // Distributed: every rank's removals, and one file written by all (the one-process file: it resumes at any rank
+  // count).
+  const par::Comm& comm = sim_.comm();
+  s.removed_particles = comm.sum(sim_.removed().particles);
+  s.removed_mass_parts = comm.sum(sim_.removed().mass).parts();
+  io::write_checkpoint(files_.checkpoint(), sim_.store(), s, &comm);
   last_checkpoint_step_ = s.step;
   ++checkpoints_;
 }
