@@ -101,11 +101,7 @@ ParticleStore<D> share_in_id_order(const ParticleStore<D>& store, const par::Com
   std::vector<ParticleId> samples;
   const std::size_t per = 4 * ranks;
   for (std::size_t k = 0; k < per && !mine.empty(); ++k) samples.push_back(store.id[mine[k * mine.size() / per]]);
-  std::vector<std::byte> bytes(samples.size() * sizeof(ParticleId));
-  if (!samples.empty()) std::memcpy(bytes.data(), samples.data(), bytes.size());
-  const std::vector<std::byte> all = comm.all_gather(bytes);
-  std::vector<ParticleId> pool(all.size() / sizeof(ParticleId));
-  if (!pool.empty()) std::memcpy(pool.data(), all.data(), all.size());
+  std::vector<ParticleId> pool = comm.all_gather_values(samples);
   std::sort(pool.begin(), pool.end());
   std::vector<ParticleId> splitters;  // rank r takes ids in [splitters[r - 1], splitters[r])
   for (std::size_t r = 1; r < ranks; ++r) splitters.push_back(pool.empty() ? 0 : pool[r * pool.size() / ranks]);
@@ -133,7 +129,6 @@ class DomainT {
       : comm_(comm), partition_(comm), edge_(reach * (1.0 + 1e-12)), anchor_(grid_anchor(Box{lo, hi})) {}
 
   const par::Comm& comm() const { return comm_; }
-  double edge() const { return edge_; }
 
   /// Cuts the cells between the ranks by the weight of the fluid in them. Collective. With `replicated`, every rank
   /// holds the same particles (the set-up, a checkpoint read by all) and passes an equal share of the cells.
@@ -223,14 +218,8 @@ class DomainT {
         w[static_cast<std::size_t>(owner_of(store.x[i]))] += static_cast<double>(1u << integ.bin(store.level[i]));
     }
     std::vector<double> total(w.size(), 0.0);
-    std::vector<std::byte> mine(w.size() * sizeof(double));
-    std::memcpy(mine.data(), w.data(), mine.size());
-    const std::vector<std::byte> all = comm_.all_gather(mine);
-    for (std::size_t k = 0; k < all.size() / sizeof(double); ++k) {
-      double x = 0.0;
-      std::memcpy(&x, all.data() + k * sizeof(double), sizeof(double));
-      total[k % w.size()] += x;
-    }
+    const std::vector<double> all = comm_.all_gather_values(w);
+    for (std::size_t k = 0; k < all.size(); ++k) total[k % w.size()] += all[k];
     double sum = 0.0, most = 0.0;
     for (const double x : total) {
       sum += x;

@@ -154,9 +154,6 @@ class SimulationT {
   double next_dt() const;
   /// The step's limits over every rank (the same on all); the limits as they are in one process.
   SweepLimits global(const SweepLimits& lim) const;
-  /// Distributed: the halos exchanged, then each particle's output count and the smoothing-length range over
-  /// every rank; then build_neighbours.
-  void exchange_and_build();
   /// The activity of substep k, with its due_prefix filled when only some bins are due.
   Activity activity(int k, int finest);
   /// Adds a finished step's work (finest bin, summed limits of its sweeps) to work_.

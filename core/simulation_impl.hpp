@@ -33,29 +33,13 @@ std::uint32_t SimulationT<D>::output_count(const ParticleView<D>& view, std::siz
 
 template <int D>
 void SimulationT<D>::prepare_neighbours() {
-  if (domain_) {
-    exchange_and_build();
-    return;
+  if (domain_) {  // distributed: halos and migration first
+    const ExchangeCounts c = domain_->exchange(store_);
+    exchanged_.migrated += c.migrated;
+    exchanged_.halos += c.halos;
+    exchanged_.bytes += c.bytes;
+    exchanged_.seconds += c.seconds;
   }
-  const auto view = store_.view();
-  expand_offsets_.resize(view.n + 1);
-  const SmoothingRange hr = par::accumulate(
-      view.n, SmoothingRange{},
-      [&](SmoothingRange& r, std::size_t i) {
-        expand_offsets_[i] = output_count(view, i);
-        r.add(view.kind[i], view.h[i], view.level[i]);
-      },
-      [](const SmoothingRange& a, const SmoothingRange& b) { return a.merged(b); });
-  build_neighbours(hr);
-}
-
-template <int D>
-void SimulationT<D>::exchange_and_build() {
-  const ExchangeCounts c = domain_->exchange(store_);
-  exchanged_.migrated += c.migrated;
-  exchanged_.halos += c.halos;
-  exchanged_.bytes += c.bytes;
-  exchanged_.seconds += c.seconds;
   const auto view = store_.view();
   expand_offsets_.resize(view.n + 1);
   SmoothingRange hr = par::accumulate(
@@ -65,8 +49,10 @@ void SimulationT<D>::exchange_and_build() {
         r.add(view.kind[i], view.h[i], view.level[i]);
       },
       [](const SmoothingRange& a, const SmoothingRange& b) { return a.merged(b); });
-  // The layers and their cell sizes come from every rank's fluid, as in one process.
-  for (const SmoothingRange& other : domain_->comm().all_gather_value(hr)) hr = hr.merged(other);
+  // Distributed, the layers and their cell sizes come from every rank's fluid, as in one process.
+  if (domain_) {
+    for (const SmoothingRange& other : domain_->comm().all_gather_value(hr)) hr = hr.merged(other);
+  }
   build_neighbours(hr);
 }
 
@@ -74,10 +60,7 @@ template <int D>
 SweepLimits SimulationT<D>::global(const SweepLimits& lim) const {
   if (!domain_) return lim;
   SweepLimits g;
-  for (const SweepLimits& o : domain_->comm().all_gather_value(lim)) {
-    g = SweepLimits{std::min(g.dt_force, o.dt_force), std::min(g.dt_cfl, o.dt_cfl), g.pairs + o.pairs,
-                    std::max(g.finest_bin, o.finest_bin), g.candidates + o.candidates};
-  }
+  for (const SweepLimits& o : domain_->comm().all_gather_value(lim)) g = g.merged(o);
   return g;
 }
 

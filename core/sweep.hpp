@@ -33,6 +33,12 @@ struct SweepLimits {
   std::size_t pairs = 0;                                      // interacting pairs evaluated
   int finest_bin = 0;                                         // largest bin of a due fluid particle
   std::size_t candidates = 0;                                 // candidates checked (in the runs scanned)
+
+  /// The limits of two sets of particles together (threads' shares of a sweep, or ranks').
+  SweepLimits merged(const SweepLimits& o) const {
+    return SweepLimits{std::min(dt_force, o.dt_force), std::min(dt_cfl, o.dt_cfl), pairs + o.pairs,
+                       std::max(finest_bin, o.finest_bin), candidates + o.candidates};
+  }
 };
 
 /// 2^-b and 2^b for a bin b (a table: std::ldexp in the pair loop cost 6 % of a step).
@@ -165,10 +171,7 @@ class PairSweep {
           lim.finest_bin = bi;
           return lim;
         },
-        [](const SweepLimits& x, const SweepLimits& y) {
-          return SweepLimits{std::min(x.dt_force, y.dt_force), std::min(x.dt_cfl, y.dt_cfl), x.pairs + y.pairs,
-                             std::max(x.finest_bin, y.finest_bin), x.candidates + y.candidates};
-        });
+        [](const SweepLimits& x, const SweepLimits& y) { return x.merged(y); });
   }
 
  private:

@@ -121,25 +121,6 @@ std::vector<std::byte> Comm::exchange(const std::vector<std::vector<std::byte>>&
   return out[0];
 }
 
-std::vector<std::byte> Comm::gather(const std::vector<std::byte>& mine, int root, std::vector<std::size_t>* from) const {
-#ifdef SPH_MPI
-  if (native_ != nullptr) {
-    int n = as_count(mine.size());
-    std::vector<int> counts(static_cast<std::size_t>(size_), 0);
-    check(MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, root, mpi(*this)), "gather");
-    const std::vector<int> at = displacements(counts);
-    std::vector<std::byte> all(rank_ == root ? static_cast<std::size_t>(at.back() + counts.back()) : 0);
-    check(MPI_Gatherv(mine.data(), n, MPI_BYTE, all.data(), counts.data(), at.data(), MPI_BYTE, root, mpi(*this)),
-          "gatherv");
-    if (rank_ == root) set_from(from, counts);
-    return all;
-  }
-#endif
-  (void)root;
-  set_from(from, {static_cast<int>(mine.size())});
-  return mine;
-}
-
 std::vector<std::byte> Comm::all_gather(const std::vector<std::byte>& mine, std::vector<std::size_t>* from) const {
 #ifdef SPH_MPI
   if (native_ != nullptr) {
@@ -156,19 +137,6 @@ std::vector<std::byte> Comm::all_gather(const std::vector<std::byte>& mine, std:
 #endif
   set_from(from, {static_cast<int>(mine.size())});
   return mine;
-}
-
-void Comm::broadcast(std::vector<std::byte>& bytes, int root) const {
-#ifdef SPH_MPI
-  if (native_ != nullptr) {
-    std::uint64_t n = bytes.size();
-    check(MPI_Bcast(&n, 1, MPI_UINT64_T, root, mpi(*this)), "bcast");
-    bytes.resize(n);
-    check(MPI_Bcast(bytes.data(), as_count(n), MPI_BYTE, root, mpi(*this)), "bcast");
-  }
-#endif
-  (void)bytes;
-  (void)root;
 }
 
 void Comm::barrier() const {

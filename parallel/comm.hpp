@@ -37,24 +37,25 @@ class Comm {
   /// rank sent here, concatenated in rank order, with `from[r]` the bytes that came from rank r.
   std::vector<std::byte> exchange(const std::vector<std::vector<std::byte>>& out,
                                   std::vector<std::size_t>* from = nullptr) const;
-  /// Every rank's bytes, concatenated in rank order, at `root` (empty elsewhere); `from` as in exchange().
-  std::vector<std::byte> gather(const std::vector<std::byte>& mine, int root = 0,
-                                std::vector<std::size_t>* from = nullptr) const;
   /// Every rank's bytes, concatenated in rank order, on every rank.
   std::vector<std::byte> all_gather(const std::vector<std::byte>& mine, std::vector<std::size_t>* from = nullptr) const;
-  /// root's bytes on every rank.
-  void broadcast(std::vector<std::byte>& bytes, int root = 0) const;
   void barrier() const;
 
   /// A trivially copyable value from every rank, in rank order.
   template <class T>
   std::vector<T> all_gather_value(const T& mine) const {
     static_assert(std::is_trivially_copyable_v<T>);
-    std::vector<std::byte> b(sizeof(T));
-    std::memcpy(b.data(), &mine, sizeof(T));
+    return all_gather_values(std::vector<T>{mine});
+  }
+
+  /// Every rank's values (plain data), concatenated in rank order, on every rank.
+  template <class T>
+  std::vector<T> all_gather_values(const std::vector<T>& mine) const {
+    std::vector<std::byte> b(mine.size() * sizeof(T));
+    if (!mine.empty()) std::memcpy(b.data(), static_cast<const void*>(mine.data()), b.size());
     const std::vector<std::byte> all = all_gather(b);
     std::vector<T> out(all.size() / sizeof(T));
-    std::memcpy(out.data(), all.data(), all.size());
+    if (!out.empty()) std::memcpy(static_cast<void*>(out.data()), all.data(), all.size());
     return out;
   }
 

@@ -22,7 +22,6 @@ class Partition {
   void cut(int dim, const std::vector<double>& coords, const std::vector<double>& weights);
   /// The rank that owns the point (dim coordinates), from the cuts of the last cut(); 0 before any.
   int owner(const double* point) const;
-  bool cut_yet() const { return cut_; }
 
   struct Zoltan;  // Zoltan's handle and the points of a cut() for its callbacks (MPI build)
 

@@ -34,9 +34,9 @@ TEST(Comm, OneProcessIsOneRankWhoseCollectivesReturnWhatTheyGet) {
   std::vector<std::size_t> from;
   EXPECT_EQ(c.exchange({bytes}, &from), bytes);
   EXPECT_EQ(from, std::vector<std::size_t>{3});
-  EXPECT_EQ(c.gather(bytes), bytes);
   EXPECT_EQ(c.all_gather(bytes), bytes);
   EXPECT_EQ(c.all_gather_value(42), std::vector<int>{42});
+  EXPECT_EQ(c.all_gather_values(std::vector<double>{1.5, -2.0}), (std::vector<double>{1.5, -2.0}));
   EXPECT_THROW(c.exchange({bytes, bytes}), std::logic_error) << "one buffer per rank";
 }
 

@@ -72,12 +72,7 @@ std::vector<std::pair<double, double>> front_edges(const ParticleStore<D>& store
 /// Every rank's pairs (each rank's own fluid), on every rank; the pairs as they are in one process.
 std::vector<std::pair<double, double>> everyones(const par::Comm* comm, std::vector<std::pair<double, double>> v) {
   if (comm == nullptr || !comm->distributed()) return v;
-  std::vector<std::byte> mine(v.size() * sizeof(v[0]));
-  if (!v.empty()) std::memcpy(mine.data(), v.data(), mine.size());
-  const std::vector<std::byte> all = comm->all_gather(mine);
-  std::vector<std::pair<double, double>> out(all.size() / sizeof(v[0]));
-  if (!out.empty()) std::memcpy(static_cast<void*>(out.data()), all.data(), all.size());
-  return out;
+  return comm->all_gather_values(v);
 }
 
 template <int D>
