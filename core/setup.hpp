@@ -96,13 +96,21 @@ std::vector<Vec<D>> lattice_round(const Vec<D>& centre, double radius, double d)
   }
 }
 
-/// Appends fluid particles at the given points, at rest density rho0, mass rho0 d^D.
+/// Appends fluid particles at the given points, at rest density rho0, mass rho0 d^D; returns the store index of the
+/// first. The k-th point gets the k-th of points.size() fresh ids. With a `stride` > 1, only the points with
+/// k % stride == offset are added (with the ids they would have): the share of one of `stride` ranks, which together
+/// hold the block once (issue #19: no rank holds the whole set-up).
 template <int D>
 std::size_t add_fluid(ParticleStore<D>& store, const std::vector<Vec<D>>& points, const FluidBlockSpecT<D>& spec,
-                      double rho0) {
-  const std::size_t first = store.append(points.size());
-  for (std::size_t k = 0; k < points.size(); ++k) {
-    const std::size_t i = first + k;
+                      double rho0, std::size_t stride = 1, std::size_t offset = 0) {
+  const ParticleId id0 = store.take_ids(points.size());
+  const std::size_t first = store.size();
+  const std::size_t count = points.size() / stride + (offset < points.size() % stride ? 1 : 0);
+  store.resize(first + count);
+  for (std::size_t c = 0; c < count; ++c) {
+    const std::size_t k = c * stride + offset;
+    const std::size_t i = first + c;
+    store.id[i] = id0 + k;
     store.x[i] = points[k];
     store.v[i] = spec.velocity;
     store.a[i].setZero();

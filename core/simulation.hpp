@@ -117,6 +117,7 @@ class SimulationT {
   void run_until(double t_end);
 
   void add_stage(std::unique_ptr<Stage> stage) { stages_.push_back(std::move(stage)); }
+  const std::vector<std::unique_ptr<Stage>>& stages() const { return stages_; }
   /// Runs every stage once; refreshes if one changed the particles.
   void run_stages();
 
@@ -124,11 +125,13 @@ class SimulationT {
   const SweepLimits& last_limits() const { return limits_; }
   const char* sweep_name() const { return sweep_->name(); }
 
-  /// Runs across the ranks of `comm` (issue #19, core/domain.hpp). Every rank must hold the same particles, the
-  /// whole set (the set-up, or a checkpoint every rank read): the cells are cut between the ranks, each keeps its
+  /// Runs across the ranks of `comm` (issue #19, core/domain.hpp): the cells are cut between the ranks, each keeps its
   /// own fluid (and every wall particle) with its rates as they are, and the neighbours are rebuilt with the halos.
-  /// Collective. With one rank nothing changes.
-  void distribute(const par::Comm& comm);
+  /// With `replicated`, every rank holds the same whole set (a set-up built whole, as the tests do) and keeps its
+  /// share; without, the ranks hold disjoint parts of the fluid (a set-up built in shares, a checkpoint read in
+  /// slabs), and every wall particle, and the fluid moves to its owners. Collective; with one rank nothing changes.
+  /// Call it again to recut from scratch (the cells follow the largest smoothing length).
+  void distribute(const par::Comm& comm, bool replicated = true);
   /// The decomposition when the run is distributed (nullptr in one process).
   const DomainT<D>* domain() const { return domain_.get(); }
   const par::Comm& comm() const { return domain_ ? domain_->comm() : par::Comm::world(); }

@@ -65,15 +65,15 @@ SweepLimits SimulationT<D>::global(const SweepLimits& lim) const {
 }
 
 template <int D>
-void SimulationT<D>::distribute(const par::Comm& comm) {
+void SimulationT<D>::distribute(const par::Comm& comm, bool replicated) {
   if (!comm.distributed()) return;
   remove_ghosts();
   // Decomposition cells as wide as the largest pair support of the set-up, 2 h_max: refinement only makes h smaller.
   const double reach = 2.0 * comm.max(smoothing_range(store_).max());
   domain_ = std::make_unique<DomainT<D>>(comm, settings_.geometry.container.lo, settings_.geometry.container.hi,
                                          reach > 0.0 ? reach : 1.0);
-  domain_->partition(store_, integrator_, true);
-  domain_->exchange(store_, true);
+  domain_->partition(store_, integrator_, replicated);
+  domain_->exchange(store_, replicated);
   // Each particle keeps its rates (the set-up's evaluation, or a checkpoint's: the rates the next step opens with),
   // and the limits are the whole set's already; only the grid is rebuilt, with the halos.
   prepare_neighbours();
@@ -215,7 +215,7 @@ void SimulationT<D>::store_restored() {
   int finest = 0;
   for (std::size_t i = 0; i < s.n; ++i)
     if (s.kind[i] == Kind::fluid) finest = std::max(finest, integrator_.bin(s.level[i]));
-  limits_.finest_bin = finest;
+  limits_.finest_bin = domain_ ? static_cast<int>(domain_->comm().max(static_cast<double>(finest))) : finest;
 }
 
 template <int D>

@@ -232,7 +232,8 @@ void commit_part(const std::filesystem::path& file, const par::Comm* comm) {
 }
 
 template <class T>
-void read_dataset(hid_t group, const std::string& name, std::vector<T>& values) {
+void read_dataset(hid_t group, const std::string& name, std::vector<T>& values,
+                  std::optional<std::pair<hsize_t, hsize_t>> rows = std::nullopt) {
   using Tr = H5Traits<T>;
   const Handle set(H5Dopen2(group, name.c_str(), kDefault), H5Dclose, "open dataset " + name);
   const Handle space(H5Dget_space(set), H5Sclose, "get the dataspace of " + name);
@@ -244,8 +245,20 @@ void read_dataset(hid_t group, const std::string& name, std::vector<T>& values) 
   if (static_cast<int>(rank == 2 ? dims[1] : 1) != Tr::components) {
     throw std::runtime_error("HDF5: dataset " + name + " has the wrong number of components");
   }
-  values.resize(dims[0], zero_value<T>());
-  if (!values.empty()) check(H5Dread(set, Tr::type(), H5S_ALL, H5S_ALL, kDefault, values.data()), "read dataset " + name);
+  if (!rows) {
+    values.resize(dims[0], zero_value<T>());
+    if (!values.empty()) check(H5Dread(set, Tr::type(), H5S_ALL, H5S_ALL, kDefault, values.data()), "read dataset " + name);
+    return;
+  }
+  // Rows [first, last) only: a hyperslab of the file's dataspace into a memory space of that many rows.
+  const auto [first, last] = *rows;
+  if (last > dims[0] || first > last) throw std::runtime_error("HDF5: dataset " + name + " has fewer rows than the checkpoint's particles");
+  values.resize(last - first, zero_value<T>());
+  if (values.empty()) return;
+  const hsize_t start[2] = {first, 0}, count[2] = {last - first, dims[1]};
+  check(H5Sselect_hyperslab(space, H5S_SELECT_SET, start, nullptr, count, nullptr), "select rows of " + name);
+  const Handle memory(H5Screate_simple(rank, count, nullptr), H5Sclose, "a memory dataspace for " + name);
+  check(H5Dread(set, Tr::type(), memory, space, kDefault, values.data()), "read rows of dataset " + name);
 }
 
 /// The particles a file holds (fluid and walls: not ghosts, not halos), in id order: the order is the particles'
@@ -454,7 +467,7 @@ int checkpoint_dimension(const std::filesystem::path& file) {
 }
 
 template <int D>
-CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore<D>& store) {
+CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore<D>& store, const par::Comm* comm) {
   if (const int dim = checkpoint_dimension(file); dim != D) {
     throw std::runtime_error(file.string() + " is a " + std::to_string(dim) + "D checkpoint; this run is " +
                              std::to_string(D) + "D");
@@ -490,10 +503,23 @@ CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore
   s.scene = read_string_attribute(g, "scene");
   const auto n = read_attribute<std::uint64_t>(g, "particles", H5T_NATIVE_UINT64);
   store.clear();
-  store.for_each_field([&](auto& field) {
-    read_dataset(g, std::string(field.name()), field.values());
-    if (field.size() != n) throw std::runtime_error(file.string() + ": field " + std::string(field.name()) + " has the wrong size");
-  });
+  if (comm == nullptr || !comm->distributed()) {
+    store.for_each_field([&](auto& field) {
+      read_dataset(g, std::string(field.name()), field.values());
+      if (field.size() != n) throw std::runtime_error(file.string() + ": field " + std::string(field.name()) + " has the wrong size");
+    });
+    store.set_next_id(s.next_id);
+    return s;
+  }
+  // This rank's slab; then every slab's wall particles on every rank (in rank order, which is id order).
+  const auto r = static_cast<hsize_t>(comm->rank()), p = static_cast<hsize_t>(comm->size());
+  const std::pair<hsize_t, hsize_t> rows{n * r / p, n * (r + 1) / p};
+  store.for_each_field([&](auto& field) { read_dataset(g, std::string(field.name()), field.values(), rows); });
+  std::vector<std::byte> walls;
+  for (std::size_t i = 0; i < store.size(); ++i)
+    if (store.kind[i] == Kind::wall) pack_particle(store, i, walls);
+  store.compact([&](std::size_t i) { return store.kind[i] != Kind::wall; });
+  unpack_particles(store, comm->all_gather(walls));
   store.set_next_id(s.next_id);
   return s;
 }
@@ -506,7 +532,7 @@ template void write_checkpoint<2>(const std::filesystem::path&, const ParticleSt
                                   const par::Comm*);
 template void write_checkpoint<3>(const std::filesystem::path&, const ParticleStore<3>&, const CheckpointState&,
                                   const par::Comm*);
-template CheckpointState read_checkpoint<2>(const std::filesystem::path&, ParticleStore<2>&);
-template CheckpointState read_checkpoint<3>(const std::filesystem::path&, ParticleStore<3>&);
+template CheckpointState read_checkpoint<2>(const std::filesystem::path&, ParticleStore<2>&, const par::Comm*);
+template CheckpointState read_checkpoint<3>(const std::filesystem::path&, ParticleStore<3>&, const par::Comm*);
 
 }  // namespace sph::io

@@ -90,8 +90,12 @@ std::string checkpoint_problem(const std::filesystem::path& file);
 int checkpoint_dimension(const std::filesystem::path& file);
 
 /// Reads a checkpoint into `store` (replacing its particles and next id). Throws std::runtime_error, also when
-/// the checkpoint was written in another dimension.
+/// the checkpoint was written in another dimension. With `comm` of several ranks, each rank reads only its slab of
+/// the rows (rank r of P: rows [r n / P, (r + 1) n / P)), and the wall particles of every slab are shared so that
+/// every rank holds them all: the ranks hold the fluid once between them (SimulationT::distribute(comm, false) then
+/// sends it to its owners). Collective then.
 template <int D>
-CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore<D>& store);
+CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore<D>& store,
+                                const par::Comm* comm = nullptr);
 
 }  // namespace sph::io

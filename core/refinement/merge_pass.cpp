@@ -44,10 +44,16 @@ struct FamilyOutcome {
 template <int D>
 MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::uint8_t>& may_merge,
                                 const Geometry<D>& geometry, double time,
-                                const std::function<bool(const Vec<D>&, const Vec<D>&)>& would_split) {
+                                const std::function<bool(const Vec<D>&, const Vec<D>&)>& would_split,
+                                std::size_t copies_from) {
   constexpr unsigned children = kChildren<D>;
   MergeResultIn<D> result;
   const std::size_t n = store.size();
+  copies_from = std::min(copies_from, n);
+  // Lent copies leave whatever happens: with no merge, by dropping the store's tail (nothing else moves).
+  const auto drop_copies = [&] {
+    if (copies_from < n) store.resize(copies_from);
+  };
   std::vector<Candidate> cand;
   for (std::size_t i = 0; i < n; ++i) {
     if (!may_merge[i] || store.kind[i] != Kind::fluid || !has_parent(store.id[i])) continue;
@@ -69,7 +75,10 @@ MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::
     fam.push_back(f);
     k += children;
   }
-  if (fam.empty()) return result;
+  if (fam.empty()) {
+    drop_copies();
+    return result;
+  }
 
   const std::vector<Wall<D>> walls = geometry.walls();
   par::parallel_for(fam.size(), [&](std::size_t r) {
@@ -130,9 +139,16 @@ MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::
     ++result.merged;
     result.d_kinetic += f.d_kinetic;
     result.d_angular += f.d_angular;
-    for (const std::uint32_t i : f.members) drop[i] = i != f.keeper;
+    for (const std::uint32_t i : f.members) {
+      drop[i] = i != f.keeper;
+      if (i >= copies_from) result.merged_copies.push_back(store.id[i]);
+    }
   }
-  if (result.merged == 0) return result;
+  if (result.merged == 0) {
+    drop_copies();
+    return result;
+  }
+  for (std::size_t i = copies_from; i < n; ++i) drop[i] = 1;
 
   auto s = store.view();
   par::parallel_for(fam.size(), [&](std::size_t r) {
@@ -163,8 +179,10 @@ MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::
 }
 
 template MergeResultIn<2> merge_families<2>(ParticleStore<2>&, const std::vector<std::uint8_t>&, const Geometry<2>&,
-                                            double, const std::function<bool(const Vec<2>&, const Vec<2>&)>&);
+                                            double, const std::function<bool(const Vec<2>&, const Vec<2>&)>&,
+                                            std::size_t);
 template MergeResultIn<3> merge_families<3>(ParticleStore<3>&, const std::vector<std::uint8_t>&, const Geometry<3>&,
-                                            double, const std::function<bool(const Vec<3>&, const Vec<3>&)>&);
+                                            double, const std::function<bool(const Vec<3>&, const Vec<3>&)>&,
+                                            std::size_t);
 
 }  // namespace sph::refine

@@ -29,6 +29,7 @@ struct MergeResultIn {
   std::size_t kept_dispersed = 0;    // complete families left alone: a member is outside the merged particle's square
   double d_kinetic = 0.0;            // kinetic energy after - before (J/m in 2D, J in 3D), <= 0
   Angular<D> d_angular = zero_angular<D>();  // angular momentum after - before (2D: L_z)
+  std::vector<ParticleId> merged_copies;     // the ids of lent copies (see below) whose family merged
 };
 using MergeResult = MergeResultIn<2>;
 
@@ -39,9 +40,15 @@ using MergeResult = MergeResultIn<2>;
 /// puts a particle of spacing d, and where the Lennard-Jones wall force of such a particle begins), or when
 /// `would_split(X, V)` says the merged particle would be marked for a split at once. `time` is written as
 /// the merged particle's level_time.
+///
+/// Across ranks (DomainT::lend_families), the store's particles from index `copies_from` on are copies of other
+/// ranks' members, lent so that a family split over ranks is whole here. A copy merges like a member, but never holds
+/// the merged particle (this rank holds the family's lowest sibling, at a lower index), and every copy leaves the
+/// store; the ids of those whose family merged are returned, for their ranks to remove the originals.
 template <int D>
 MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::uint8_t>& may_merge,
                                 const Geometry<D>& geometry, double time,
-                                const std::function<bool(const Vec<D>&, const Vec<D>&)>& would_split = {});
+                                const std::function<bool(const Vec<D>&, const Vec<D>&)>& would_split = {},
+                                std::size_t copies_from = static_cast<std::size_t>(-1));
 
 }  // namespace sph::refine

@@ -41,6 +41,8 @@ class RefinementStageIn final : public StageT<D> {
   const std::vector<PassRecordIn<D>>& log() const { return log_; }
   std::size_t total_refined() const { return total_; }
   std::size_t total_merged() const { return total_merged_; }
+  /// Of those, the families merged on this rank with members lent by others (runs across ranks).
+  std::size_t merged_across_ranks() const { return merged_across_; }
 
  private:
   RefinementSettings settings_;
@@ -48,6 +50,7 @@ class RefinementStageIn final : public StageT<D> {
   std::vector<PassRecordIn<D>> log_;
   std::size_t total_ = 0;
   std::size_t total_merged_ = 0;
+  std::size_t merged_across_ = 0;
 };
 
 using RefinementStage = RefinementStageIn<2>;
@@ -55,6 +58,15 @@ using RefinementStage = RefinementStageIn<2>;
 /// Adds dynamic refinement to a simulation; returns the stage (owned by the simulation) for its log.
 template <int D>
 RefinementStageIn<D>& add_refinement_stage(SimulationT<D>& sim, const RefinementSettings& settings);
+
+/// The merge pass on a simulation's store: merges the families all of whose members have may[i] != 0
+/// (merge_families). In a distributed run, a family whose members sit on several ranks is first brought whole to one
+/// of them (DomainT::lend_families), and the others remove the originals of the families that merged (collective);
+/// `across`, when given, is increased by the families this rank merged so. The caller refreshes the simulation.
+template <int D>
+MergeResultIn<D> merge_pass(SimulationT<D>& sim, std::vector<std::uint8_t>& may,
+                            const std::function<bool(const Vec<D>&, const Vec<D>&)>& would_split = {},
+                            std::size_t* across = nullptr);
 
 /// Static refinement at set-up: splits every fluid particle (fully refined runs) or those in a box, then
 /// refreshes the simulation. Returns how many were split. (2D and 3D.)

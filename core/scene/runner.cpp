@@ -1,8 +1,10 @@
 #include "core/scene/runner.hpp"
 
 #include <omp.h>
+#include <sys/resource.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -11,6 +13,7 @@
 #include "core/io/atomic_file.hpp"
 #include "core/io/hdf5_frames.hpp"
 #include "core/io/time_series.hpp"
+#include "core/refinement/refinement_stage.hpp"
 #include "core/scene/scene_builder.hpp"
 #include "core/scene/scene_parser.hpp"
 #include "parallel/comm.hpp"
@@ -59,10 +62,11 @@ RunnerT<D>::RunnerT(Scene scene, RunOptions options)
     : scene_(std::move(scene)),
       options_(std::move(options)),
       files_{options_.folder},
-      sim_(build_simulation<D>(scene_)),
+      sim_(build_simulation<D>(scene_, &par::Comm::world())),  // distributed: each rank builds its share
       probes_(scene_) {
   if (options_.resume) {
-    io::CheckpointState state = io::read_checkpoint(*options_.resume, sim_.store());
+    // Distributed: each rank reads its slab of the rows (and every wall particle), then the fluid goes to its owners.
+    io::CheckpointState state = io::read_checkpoint(*options_.resume, sim_.store(), &par::Comm::world());
     Scene original;
     try {
       original = scene_from_json(Json::parse(state.scene));
@@ -80,6 +84,7 @@ RunnerT<D>::RunnerT(Scene scene, RunOptions options)
     }
     sim_.set_clock(state.time, state.step, dt);
     sim_.set_fine_step_count(state.fine_steps);
+    sim_.distribute(par::Comm::world(), false);
     sim_.store_restored();
     next_row_ = state.next_row;
     next_frame_ = state.next_frame;
@@ -97,14 +102,6 @@ RunnerT<D>::RunnerT(Scene scene, RunOptions options)
     if (par::Comm::world().root()) sim_.set_removed(removed);
     last_row_step_ = last_frame_step_ = last_checkpoint_step_ = state.step;
     resumed_ = true;
-  }
-  if (par::Comm::world().distributed()) {
-    if (scene_.effects.refinement && scene_.effects.refinement->coarsening) {
-      throw SceneError("effects.refinement.coarsening",
-                       "coarsening does not run across ranks yet (issue #19): run this scene in one process, or "
-                       "without coarsening (splits alone do run across ranks)");
-    }
-    sim_.distribute(par::Comm::world());  // every rank built (or read) the whole set: each keeps its share
   }
   if (!resumed_) {
     const DiagnosticsT<D> d = sim_.diagnostics();
@@ -355,6 +352,20 @@ void RunnerT<D>::write_summary(const Summary& r, const FailureReport* failure) {
   const std::uint64_t migrated = comm.sum(sim_.exchanged().migrated), halos = comm.sum(sim_.exchanged().halos),
                       bytes = comm.sum(sim_.exchanged().bytes);
   const double exchange_seconds = comm.max(sim_.exchanged().seconds);
+  // The largest peak resident set of the ranks (the process's, in one process): what one machine must hold.
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const double peak_rss = comm.max(static_cast<double>(usage.ru_maxrss) * 1024.0);
+  // Dynamic refinement in this invocation: particles split, families merged, and (across ranks) the families
+  // merged with members lent by another rank.
+  std::optional<std::array<std::uint64_t, 3>> passes;
+  for (const auto& stage : sim_.stages()) {
+    if (const auto* rs = dynamic_cast<const refine::RefinementStageIn<D>*>(stage.get())) {
+      passes = std::array<std::uint64_t, 3>{comm.sum(std::uint64_t{rs->total_refined()}),
+                                            comm.sum(std::uint64_t{rs->total_merged()}),
+                                            comm.sum(std::uint64_t{rs->merged_across_ranks()})};
+    }
+  }
   if (options_.folder.empty() || !comm.root()) return;
   Json j;
   j["scene"] = scene_.name;
@@ -385,6 +396,7 @@ void RunnerT<D>::write_summary(const Summary& r, const FailureReport* failure) {
   j["step"] = r.final.step;
   j["steps_this_run"] = r.steps;
   j["wall_seconds"] = r.wall_seconds;
+  j["peak_rss_bytes"] = peak_rss;
   j["particle_steps"] = r.particle_steps;
   j["particle_steps_per_second"] = r.wall_seconds > 0.0 ? static_cast<double>(r.particle_steps) / r.wall_seconds : 0.0;
   j["fluid_per_level"] = r.final.per_level;
@@ -401,6 +413,10 @@ void RunnerT<D>::write_summary(const Summary& r, const FailureReport* failure) {
     j["pair_interactions"] = w.pairs;
     j["neighbour_candidates"] = w.candidates;
     j["sweeps"] = w.substeps;
+  }
+  if (passes) {
+    j["refinement"] = {{"split", (*passes)[0]}, {"merged_families", (*passes)[1]},
+                       {"merged_families_across_ranks", (*passes)[2]}};
   }
   j["removed_particles"] = r.final.removed;
   j["removed_mass"] = r.final.removed_mass;

@@ -39,7 +39,7 @@ SolverSettingsT<D> solver_settings(const Scene& scene) {
 }
 
 template <int D>
-SimulationT<D> build_simulation(const Scene& scene) {
+SimulationT<D> build_simulation(const Scene& scene, const par::Comm* comm) {
   if (dimension(scene) != D) {
     throw std::invalid_argument("build_simulation<" + std::to_string(D) + ">: the scene is " +
                                 std::to_string(dimension(scene)) + "D");
@@ -49,6 +49,8 @@ SimulationT<D> build_simulation(const Scene& scene) {
   ParticleStore<D>& store = sim.store();
   const double g = gravity_magnitude(scene);
   constexpr int up = D - 1;
+  const bool shared = comm != nullptr && comm->distributed();
+  const auto stride = shared ? static_cast<std::size_t>(comm->size()) : 1, offset = shared ? static_cast<std::size_t>(comm->rank()) : 0;
   for (const FluidRegion& f : scene.fluid) {
     const double d = f.lattice_spacing();
     const std::vector<Vec<D>> points = f.shape == Shape::rectangle
@@ -59,7 +61,7 @@ SimulationT<D> build_simulation(const Scene& scene) {
     block.h_factor = scene.h_factor;
     block.level = f.level;
     block.velocity = f.velocity.fixed<D>();
-    const std::size_t first = add_fluid(store, points, block, settings.eos.rho0);
+    const std::size_t first = add_fluid(store, points, block, settings.eos.rho0, stride, offset);
     if (f.hydrostatic) {
       const double surface = f.surface.value_or(f.shape == Shape::rectangle ? f.rect.hi[up] : f.centre[up] + f.radius);
       set_hydrostatic(store, first, store.size(), surface, g, settings.eos);
@@ -68,6 +70,7 @@ SimulationT<D> build_simulation(const Scene& scene) {
   if (settings.lennard_jones) {
     add_wall_particles(store, settings.geometry.walls(), settings.lennard_jones->spacing, settings.eos.rho0);
   }
+  if (shared) sim.distribute(*comm, false);
   sim.refresh();
   if (const auto& st = scene.effects.static_refinement) {
     if (st->box) {
@@ -75,6 +78,8 @@ SimulationT<D> build_simulation(const Scene& scene) {
     } else {
       refine::refine_all(sim, st->pattern, st->rsp_k);
     }
+    // The decomposition cells follow the largest support, which a split of every particle halves.
+    if (shared) sim.distribute(*comm, false);
   }
   if (scene.effects.refinement) refine::add_refinement_stage(sim, *scene.effects.refinement);
   return sim;
@@ -82,7 +87,7 @@ SimulationT<D> build_simulation(const Scene& scene) {
 
 template SolverSettingsT<2> solver_settings<2>(const Scene&);
 template SolverSettingsT<3> solver_settings<3>(const Scene&);
-template SimulationT<2> build_simulation<2>(const Scene&);
-template SimulationT<3> build_simulation<3>(const Scene&);
+template SimulationT<2> build_simulation<2>(const Scene&, const par::Comm*);
+template SimulationT<3> build_simulation<3>(const Scene&, const par::Comm*);
 
 }  // namespace sph::scene

@@ -5,7 +5,7 @@
 resumes at another to the uninterrupted run's end, bit for bit.
 
 usage: test_ranks.py SPHREFINE MPIEXEC SCENE OUT [--configs 1x2,2x1,...] [--set key=value ...]
-                     [--resume-at T --resume-ranks A,B] [--expect-recut]
+                     [--resume-at T --resume-ranks A,B] [--expect-recut] [--expect-merge-across]
 """
 import argparse
 import json
@@ -93,6 +93,9 @@ def main():
     ap.add_argument("--resume-ranks", default="2,3")
     ap.add_argument("--expect-recut", action="store_true",
                     help="fail unless some run recut its cells (so that a rebalance is among what is compared)")
+    ap.add_argument("--expect-merge-across", action="store_true",
+                    help="fail unless the reference merged families and some run merged one whose members sat on "
+                         "several ranks (so that coarsening across ranks is among what is compared)")
     args = ap.parse_args()
     out = Path(args.out)
     if out.exists():
@@ -100,13 +103,19 @@ def main():
     configs = [tuple(int(v) for v in c.split("x")) for c in args.configs.split(",")]
     reference = out / "np1_t1"
     run(args, 1, 1, reference)
-    recuts = 0
+    recuts = across = 0
     for n, t in configs:
         folder = out / f"np{n}_t{t}"
         run(args, n, t, folder)
         compare(reference, folder, f"{n} rank(s) x {t} thread(s)")
-        recuts += len(json.loads((folder / "run.json").read_text()).get("exchange", {}).get("rebalances", []))
-    print(f"recuts of the cells among these runs: {recuts}")
+        summary = json.loads((folder / "run.json").read_text())
+        recuts += len(summary.get("exchange", {}).get("rebalances", []))
+        across += summary.get("refinement", {}).get("merged_families_across_ranks", 0)
+    merged = json.loads((reference / "run.json").read_text()).get("refinement", {}).get("merged_families", 0)
+    print(f"recuts of the cells among these runs: {recuts}; families merged in the reference: {merged}, "
+          f"merged with members lent across ranks among the runs: {across}")
+    if args.expect_merge_across and (merged == 0 or across == 0):
+        sys.exit("FAIL: no family merged across ranks, so coarsening across ranks was not compared")
     if args.expect_recut and recuts == 0:
         sys.exit("FAIL: no run recut its cells, so no rebalance was compared")
     if args.resume_at is not None:
