@@ -26,7 +26,7 @@ class Partition {
   struct Zoltan;  // Zoltan's handle and the points of a cut() for its callbacks (MPI build)
 
  private:
-  const Comm& comm_;
+  [[maybe_unused]] const Comm& comm_;  // used by the MPI build only
   std::unique_ptr<Zoltan> zoltan_;
   bool cut_ = false;
 };

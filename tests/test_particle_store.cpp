@@ -24,7 +24,7 @@ namespace sph {
 namespace {
 
 template <class T>
-inline constexpr bool kAlwaysFalse = false;
+[[maybe_unused]] inline constexpr bool kAlwaysFalse = false;  // only read by the static_assert of an unhandled type
 
 /// The value field number `salt` of the particle with this id carries. Distinct across ids and fields.
 template <class T>

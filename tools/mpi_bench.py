@@ -9,6 +9,7 @@
     one rank spent in exchanges, waiting for the other included) over the run's wall time, same difference.
   - The dynamic dam break (AAP) at 4x the paper's count (3600 particles to start, to t = 4 s): on 2 ranks x 1
     thread against 1 rank x 1 and x 2 threads, and the recuts, with the loads before and after and their cost.
+  - Memory: the largest peak resident set of the ranks (run.json's peak_rss_bytes) in the 1e6 runs.
 
 usage: mpi_bench.py SPHREFINE OUT.json  (run it on an otherwise idle machine)
 """
@@ -46,7 +47,7 @@ def step_cost(exe, ranks, threads, work):
     n = b["steps_this_run"] - a["steps_this_run"]
     step = (b["wall_seconds"] - a["wall_seconds"]) / n
     out = {"ranks": ranks, "threads": threads, "steps": n, "seconds_per_step": step,
-           "fluid": b["fluid_per_level"][0]}
+           "fluid": b["fluid_per_level"][0], "peak_rss_bytes_most_rank": b.get("peak_rss_bytes")}
     if "exchange" in b:
         ex = (b["exchange"]["seconds_most"] - a["exchange"]["seconds_most"]) / n
         out["exchange_seconds_per_step"] = ex
