@@ -26,92 +26,137 @@ struct FluidBlockSpecT {
 };
 using FluidBlockSpec = FluidBlockSpecT<2>;
 
-/// Lattice points (cell centres) of spacing d in [lo, hi].
-inline std::vector<Vec<2>> lattice_rectangle(const Vec<2>& lo, const Vec<2>& hi, double d) {
-  std::vector<Vec<2>> pts;
+/// Visits the lattice points (cell centres) of spacing d in [lo, hi], x fastest.
+template <class Visit>
+void each_rectangle_point(const Vec<2>& lo, const Vec<2>& hi, double d, Visit&& visit) {
   const auto nx = static_cast<long>(std::floor((hi[0] - lo[0]) / d + 1e-9));
   const auto ny = static_cast<long>(std::floor((hi[1] - lo[1]) / d + 1e-9));
-  pts.reserve(static_cast<std::size_t>(std::max(0L, nx * ny)));
   for (long iy = 0; iy < ny; ++iy)
     for (long ix = 0; ix < nx; ++ix)
-      pts.emplace_back(lo[0] + (static_cast<double>(ix) + 0.5) * d, lo[1] + (static_cast<double>(iy) + 0.5) * d);
-  return pts;
+      visit(Vec<2>(lo[0] + (static_cast<double>(ix) + 0.5) * d, lo[1] + (static_cast<double>(iy) + 0.5) * d));
 }
 
-/// Lattice points (cell centres) of spacing d in the 3D box [lo, hi], x fastest.
-inline std::vector<Vec<3>> lattice_box(const Vec<3>& lo, const Vec<3>& hi, double d) {
-  std::vector<Vec<3>> pts;
+/// Visits the lattice points (cell centres) of spacing d in the 3D box [lo, hi], x fastest.
+template <class Visit>
+void each_box_point(const Vec<3>& lo, const Vec<3>& hi, double d, Visit&& visit) {
   long n[3];
   for (int a = 0; a < 3; ++a) n[a] = static_cast<long>(std::floor((hi[a] - lo[a]) / d + 1e-9));
-  pts.reserve(static_cast<std::size_t>(std::max(0L, n[0] * n[1] * n[2])));
   for (long iz = 0; iz < n[2]; ++iz)
     for (long iy = 0; iy < n[1]; ++iy)
       for (long ix = 0; ix < n[0]; ++ix)
-        pts.emplace_back(lo[0] + (static_cast<double>(ix) + 0.5) * d, lo[1] + (static_cast<double>(iy) + 0.5) * d,
-                         lo[2] + (static_cast<double>(iz) + 0.5) * d);
-  return pts;
+        visit(Vec<3>(lo[0] + (static_cast<double>(ix) + 0.5) * d, lo[1] + (static_cast<double>(iy) + 0.5) * d,
+                     lo[2] + (static_cast<double>(iz) + 0.5) * d));
 }
 
-/// Lattice points of spacing d through the centre, inside the circle (the paper's drop: radius 2 m at
-/// d = 25/30 m gives its 21 particles).
-inline std::vector<Vec<2>> lattice_circle(const Vec<2>& centre, double radius, double d) {
-  std::vector<Vec<2>> pts;
+/// Visits the lattice points of spacing d through the centre inside the circle, x fastest (the paper's drop:
+/// radius 2 m at d = 25/30 m gives its 21 particles).
+template <class Visit>
+void each_circle_point(const Vec<2>& centre, double radius, double d, Visit&& visit) {
   const auto n = static_cast<long>(std::ceil(radius / d)) + 1;
   for (long iy = -n; iy <= n; ++iy)
     for (long ix = -n; ix <= n; ++ix) {
       const Vec<2> p = centre + d * Vec<2>(static_cast<double>(ix), static_cast<double>(iy));
-      if ((p - centre).norm() <= radius) pts.push_back(p);
+      if ((p - centre).norm() <= radius) visit(p);
     }
-  return pts;
 }
 
-/// Lattice points of spacing d through the centre, inside the 3D ball (x fastest).
-inline std::vector<Vec<3>> lattice_ball(const Vec<3>& centre, double radius, double d) {
-  std::vector<Vec<3>> pts;
+/// Visits the lattice points of spacing d through the centre inside the 3D ball, x fastest.
+template <class Visit>
+void each_ball_point(const Vec<3>& centre, double radius, double d, Visit&& visit) {
   const auto n = static_cast<long>(std::ceil(radius / d)) + 1;
   for (long iz = -n; iz <= n; ++iz)
     for (long iy = -n; iy <= n; ++iy)
       for (long ix = -n; ix <= n; ++ix) {
         const Vec<3> p = centre + d * Vec<3>(static_cast<double>(ix), static_cast<double>(iy), static_cast<double>(iz));
-        if ((p - centre).norm() <= radius) pts.push_back(p);
+        if ((p - centre).norm() <= radius) visit(p);
       }
-  return pts;
 }
 
-/// The lattice of a box (a rectangle in 2D) or of a ball (a disc in 2D), in D dimensions.
+/// The lattice of a box (a rectangle in 2D) or of a ball (a disc in 2D), in D dimensions, visited.
+template <int D, class Visit>
+void each_block_point(const Vec<D>& lo, const Vec<D>& hi, double d, Visit&& visit) {
+  if constexpr (D == 2) {
+    each_rectangle_point(lo, hi, d, visit);
+  } else {
+    each_box_point(lo, hi, d, visit);
+  }
+}
+template <int D, class Visit>
+void each_round_point(const Vec<D>& centre, double radius, double d, Visit&& visit) {
+  if constexpr (D == 2) {
+    each_circle_point(centre, radius, d, visit);
+  } else {
+    each_ball_point(centre, radius, d, visit);
+  }
+}
+
+inline std::vector<Vec<2>> lattice_rectangle(const Vec<2>& lo, const Vec<2>& hi, double d) {
+  std::vector<Vec<2>> pts;
+  each_rectangle_point(lo, hi, d, [&](const Vec<2>& p) { pts.push_back(p); });
+  return pts;
+}
+inline std::vector<Vec<3>> lattice_box(const Vec<3>& lo, const Vec<3>& hi, double d) {
+  std::vector<Vec<3>> pts;
+  each_box_point(lo, hi, d, [&](const Vec<3>& p) { pts.push_back(p); });
+  return pts;
+}
+inline std::vector<Vec<2>> lattice_circle(const Vec<2>& centre, double radius, double d) {
+  std::vector<Vec<2>> pts;
+  each_circle_point(centre, radius, d, [&](const Vec<2>& p) { pts.push_back(p); });
+  return pts;
+}
+inline std::vector<Vec<3>> lattice_ball(const Vec<3>& centre, double radius, double d) {
+  std::vector<Vec<3>> pts;
+  each_ball_point(centre, radius, d, [&](const Vec<3>& p) { pts.push_back(p); });
+  return pts;
+}
 template <int D>
 std::vector<Vec<D>> lattice_block(const Vec<D>& lo, const Vec<D>& hi, double d) {
-  if constexpr (D == 2) {
-    return lattice_rectangle(lo, hi, d);
-  } else {
-    return lattice_box(lo, hi, d);
-  }
+  std::vector<Vec<D>> pts;
+  each_block_point<D>(lo, hi, d, [&](const Vec<D>& p) { pts.push_back(p); });
+  return pts;
 }
 template <int D>
 std::vector<Vec<D>> lattice_round(const Vec<D>& centre, double radius, double d) {
-  if constexpr (D == 2) {
-    return lattice_circle(centre, radius, d);
-  } else {
-    return lattice_ball(centre, radius, d);
-  }
+  std::vector<Vec<D>> pts;
+  each_round_point<D>(centre, radius, d, [&](const Vec<D>& p) { pts.push_back(p); });
+  return pts;
 }
 
-/// Appends fluid particles at the given points, at rest density rho0, mass rho0 d^D; returns the store index of the
-/// first. The k-th point gets the k-th of points.size() fresh ids. With a `stride` > 1, only the points with
-/// k % stride == offset are added (with the ids they would have): the share of one of `stride` ranks, which together
-/// hold the block once (issue #19: no rank holds the whole set-up).
+/// One rank's share of a lattice (issue #19: no rank holds the whole set-up): of the `total` points a visit gives,
+/// the k-th with k % stride == offset. With stride 1, the whole lattice.
 template <int D>
-std::size_t add_fluid(ParticleStore<D>& store, const std::vector<Vec<D>>& points, const FluidBlockSpecT<D>& spec,
-                      double rho0, std::size_t stride = 1, std::size_t offset = 0) {
-  const ParticleId id0 = store.take_ids(points.size());
+struct LatticeShare {
+  std::vector<Vec<D>> points;
+  std::size_t total = 0;
+  std::size_t stride = 1, offset = 0;
+};
+/// `each(visit)` visits a lattice's points in order (each_block_point, each_round_point).
+template <int D, class Each>
+LatticeShare<D> lattice_share(Each&& each, std::size_t stride, std::size_t offset) {
+  LatticeShare<D> share;
+  share.stride = stride;
+  share.offset = offset;
+  each([&](const Vec<D>& p) {
+    if (share.total % stride == offset) share.points.push_back(p);
+    ++share.total;
+  });
+  return share;
+}
+
+/// Appends fluid particles at a share of a lattice's points, at rest density rho0, mass rho0 d^D; returns the store
+/// index of the first. The lattice's k-th point gets the k-th of its `total` fresh ids, so the ranks' shares together
+/// are the whole set-up, ids included.
+template <int D>
+std::size_t add_fluid(ParticleStore<D>& store, const LatticeShare<D>& share, const FluidBlockSpecT<D>& spec, double rho0) {
+  const ParticleId id0 = store.take_ids(share.total);
   const std::size_t first = store.size();
-  const std::size_t count = points.size() / stride + (offset < points.size() % stride ? 1 : 0);
-  store.resize(first + count);
-  for (std::size_t c = 0; c < count; ++c) {
-    const std::size_t k = c * stride + offset;
+  const std::vector<Vec<D>>& points = share.points;
+  store.resize(first + points.size());
+  for (std::size_t c = 0; c < points.size(); ++c) {
     const std::size_t i = first + c;
-    store.id[i] = id0 + k;
-    store.x[i] = points[k];
+    store.id[i] = id0 + c * share.stride + share.offset;
+    store.x[i] = points[c];
     store.v[i] = spec.velocity;
     store.a[i].setZero();
     store.rho[i] = rho0;
@@ -124,6 +169,16 @@ std::size_t add_fluid(ParticleStore<D>& store, const std::vector<Vec<D>>& points
     store.drho[i] = 0.0;
   }
   return first;
+}
+
+/// Appends fluid particles at the given points (the whole lattice: ids in their order).
+template <int D>
+std::size_t add_fluid(ParticleStore<D>& store, const std::vector<Vec<D>>& points, const FluidBlockSpecT<D>& spec,
+                      double rho0) {
+  LatticeShare<D> whole;
+  whole.points = points;
+  whole.total = points.size();
+  return add_fluid(store, whole, spec, rho0);
 }
 
 /// Hydrostatic initial density for fluid particles in [first, end): p = rho0 g (surface - height), the height

@@ -14,6 +14,7 @@
 #include "core/neighbour_cells.hpp"
 #include "core/scene/scene_builder.hpp"
 #include "core/scene/scene_parser.hpp"
+#include "core/setup.hpp"
 
 #include "tests/support/io_helpers.hpp"
 
@@ -167,3 +168,47 @@ TEST(SceneBuilder, TheGridIsSizedByTheFinestFluidSupportInScenesWithWallParticle
     }
   }
 }
+
+namespace {
+
+// The set-up across ranks (issue #19): each of P ranks generates every P-th lattice point with the id the whole
+// set-up gives it; together the shares are the whole set-up, ids and positions exact, each point once.
+template <int D, class Each>
+void expect_shares_make_the_whole(Each&& each, std::size_t ranks) {
+  FluidBlockSpecT<D> spec;
+  spec.spacing = 0.25;
+  ParticleStore<D> whole;
+  whole.take_ids(7);  // ids already handed out (a block before this one)
+  add_fluid(whole, lattice_share<D>(each, 1, 0), spec, 1000.0);
+  std::vector<std::pair<ParticleId, Vec<D>>> joined;
+  ParticleId next = 0;
+  for (std::size_t r = 0; r < ranks; ++r) {
+    ParticleStore<D> part;
+    part.take_ids(7);
+    const LatticeShare<D> share = lattice_share<D>(each, ranks, r);
+    EXPECT_EQ(share.total, whole.size());
+    add_fluid(part, share, spec, 1000.0);
+    for (std::size_t i = 0; i < part.size(); ++i) joined.emplace_back(part.id[i], part.x[i]);
+    next = part.next_id();
+  }
+  EXPECT_EQ(next, whole.next_id());  // every rank hands out the same ids after the block
+  std::sort(joined.begin(), joined.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  ASSERT_EQ(joined.size(), whole.size());
+  for (std::size_t i = 0; i < whole.size(); ++i) {
+    EXPECT_EQ(joined[i].first, whole.id[i]);
+    EXPECT_EQ(joined[i].second, whole.x[i]);
+  }
+}
+
+TEST(SetUp, SharesOfALatticeOverRanksAreTheWholeLatticeWithItsIds) {
+  for (const std::size_t ranks : {1u, 2u, 3u, 4u}) {
+    expect_shares_make_the_whole<2>(
+        [](auto&& visit) { each_rectangle_point(Vec<2>(0, 0), Vec<2>(2.5, 1.75), 0.25, visit); }, ranks);
+    expect_shares_make_the_whole<2>([](auto&& visit) { each_circle_point(Vec<2>(1, 1), 0.9, 0.25, visit); }, ranks);
+    expect_shares_make_the_whole<3>(
+        [](auto&& visit) { each_box_point(Vec<3>(0, 0, 0), Vec<3>(1.0, 0.75, 0.5), 0.25, visit); }, ranks);
+    expect_shares_make_the_whole<3>([](auto&& visit) { each_ball_point(Vec<3>(1, 1, 1), 0.6, 0.25, visit); }, ranks);
+  }
+}
+
+}  // namespace

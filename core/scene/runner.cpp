@@ -442,27 +442,24 @@ void RunnerT<D>::write_summary(const Summary& r, const FailureReport* failure) {
 template <int D>
 void RunnerT<D>::fail(const FailureReport& report) {
   std::string where;
-  if (!options_.folder.empty() && !sim_.comm().root()) {  // the collective part of the outputs below
+  if (!options_.folder.empty()) {
+    // The simulation holds the last good state: leave it behind, complete, for inspection and --resume (every rank
+    // takes part in writing it; the root says where it is).
     const std::uint64_t step = sim_.step_count();
     if (last_row_step_ != step) write_row();
     if (scene_.output.frames && last_frame_step_ != step) write_frame();
     write_checkpoint();
     write_summary(summary(), &report);
-  } else if (!options_.folder.empty()) {
-    // The simulation holds the last good state: leave it behind, complete, for inspection and --resume.
-    const std::uint64_t step = sim_.step_count();
-    if (last_row_step_ != step) write_row();
-    if (scene_.output.frames && last_frame_step_ != step) write_frame();
-    write_checkpoint();
-    write_summary(summary(), &report);
-    char buf[96];
-    std::snprintf(buf, sizeof buf, " The last good state (step %llu, t = %.6g s) is in ",
-                  static_cast<unsigned long long>(step), sim_.time());
-    where = buf;
-    if (scene_.output.frames) where += (options_.folder / frames_.back().file).string() + " and ";
-    where += files_.checkpoint().string() + (report.kind == FailureKind::left_open_top
-                                                 ? " (continue with --resume and --set container.outflow=remove)."
-                                                 : " (continue with --resume and a smaller time.cfl).");
+    if (sim_.comm().root()) {
+      char buf[96];
+      std::snprintf(buf, sizeof buf, " The last good state (step %llu, t = %.6g s) is in ",
+                    static_cast<unsigned long long>(step), sim_.time());
+      where = buf;
+      if (scene_.output.frames) where += (options_.folder / frames_.back().file).string() + " and ";
+      where += files_.checkpoint().string() + (report.kind == FailureKind::left_open_top
+                                                   ? " (continue with --resume and --set container.outflow=remove)."
+                                                   : " (continue with --resume and a smaller time.cfl).");
+    }
   }
   throw RunFailure(report.message() + "." + where, report);
 }

@@ -53,15 +53,22 @@ SimulationT<D> build_simulation(const Scene& scene, const par::Comm* comm) {
   const auto stride = shared ? static_cast<std::size_t>(comm->size()) : 1, offset = shared ? static_cast<std::size_t>(comm->rank()) : 0;
   for (const FluidRegion& f : scene.fluid) {
     const double d = f.lattice_spacing();
-    const std::vector<Vec<D>> points = f.shape == Shape::rectangle
-                                           ? lattice_block<D>(f.rect.lo.fixed<D>(), f.rect.hi.fixed<D>(), d)
-                                           : lattice_round<D>(f.centre.fixed<D>(), f.radius, d);
+    // This rank's share of the lattice (the whole lattice in one process), generated without the rest.
+    const LatticeShare<D> points = lattice_share<D>(
+        [&](auto&& visit) {
+          if (f.shape == Shape::rectangle) {
+            each_block_point<D>(f.rect.lo.fixed<D>(), f.rect.hi.fixed<D>(), d, visit);
+          } else {
+            each_round_point<D>(f.centre.fixed<D>(), f.radius, d, visit);
+          }
+        },
+        stride, offset);
     FluidBlockSpecT<D> block;
     block.spacing = d;
     block.h_factor = scene.h_factor;
     block.level = f.level;
     block.velocity = f.velocity.fixed<D>();
-    const std::size_t first = add_fluid(store, points, block, settings.eos.rho0, stride, offset);
+    const std::size_t first = add_fluid(store, points, block, settings.eos.rho0);
     if (f.hydrostatic) {
       const double surface = f.surface.value_or(f.shape == Shape::rectangle ? f.rect.hi[up] : f.centre[up] + f.radius);
       set_hydrostatic(store, first, store.size(), surface, g, settings.eos);
