@@ -9,7 +9,8 @@
     one rank spent in exchanges, waiting for the other included) over the run's wall time, same difference.
   - The dynamic dam break (AAP) at 4x the paper's count (3600 particles to start, to t = 4 s): on 2 ranks x 1
     thread against 1 rank x 1 and x 2 threads, and the recuts, with the loads before and after and their cost.
-  - Memory: the largest peak resident set of the ranks (run.json's peak_rss_bytes) in the 1e6 runs.
+  - Memory per rank: the largest peak resident set of the ranks (run.json's peak_rss_bytes) at 1, 2 and 4 ranks of
+    one thread, the 1e6-particle dam break for 15 steps (set-up included: each rank builds only its share).
 
 usage: mpi_bench.py SPHREFINE OUT.json  (run it on an otherwise idle machine)
 """
@@ -58,11 +59,23 @@ def step_cost(exe, ranks, threads, work):
     return out
 
 
+def memory(exe, work):
+    base = ["fluid[0].spacing=0.025", "output.frames=false", "probes=[]", "time.end=0.0004",
+            "time.output_interval=0.0004"]
+    rows = []
+    for ranks in (1, 2, 4):
+        r = run(exe, ranks, 1, ROOT / "cases/dam_break.json", work / f"memory_{ranks}", base)
+        rows.append({"ranks": ranks, "steps": r["steps_this_run"], "peak_rss_mib_largest_rank": r["peak_rss_bytes"] / 2**20})
+        print(json.dumps(rows[-1]), flush=True)
+    return rows
+
+
 def main():
     exe, out = sys.argv[1], Path(sys.argv[2])
     work = out.parent / "mpi_bench_runs"
     work.mkdir(parents=True, exist_ok=True)
-    result = {"step_1e6": [step_cost(exe, r, t, work) for (r, t) in ((1, 1), (1, 2), (2, 1))]}
+    result = {"step_1e6": [step_cost(exe, r, t, work) for (r, t) in ((1, 1), (1, 2), (2, 1))],
+              "memory_1e6": memory(exe, work)}
     # The dynamic dam break at 4x (d / 2, 3600 particles to start), AAP splits, on 2 ranks.
     dyn = run(exe, 2, 1, ROOT / "cases/dam_break_aap.json", work / "dynamic_2ranks",
               ["fluid[0].spacing=0.4166666666666667", "output.frames=false"])

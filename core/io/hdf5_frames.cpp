@@ -231,9 +231,13 @@ void commit_part(const std::filesystem::path& file, const par::Comm* comm) {
   comm->barrier();
 }
 
+/// Rows [first, last) of a dataset that must hold `total` rows.
+struct Rows {
+  hsize_t first = 0, last = 0, total = 0;
+};
+
 template <class T>
-void read_dataset(hid_t group, const std::string& name, std::vector<T>& values,
-                  std::optional<std::pair<hsize_t, hsize_t>> rows = std::nullopt) {
+void read_dataset(hid_t group, const std::string& name, std::vector<T>& values, std::optional<Rows> rows = std::nullopt) {
   using Tr = H5Traits<T>;
   const Handle set(H5Dopen2(group, name.c_str(), kDefault), H5Dclose, "open dataset " + name);
   const Handle space(H5Dget_space(set), H5Sclose, "get the dataspace of " + name);
@@ -251,8 +255,8 @@ void read_dataset(hid_t group, const std::string& name, std::vector<T>& values,
     return;
   }
   // Rows [first, last) only: a hyperslab of the file's dataspace into a memory space of that many rows.
-  const auto [first, last] = *rows;
-  if (last > dims[0] || first > last) throw std::runtime_error("HDF5: dataset " + name + " has fewer rows than the checkpoint's particles");
+  if (dims[0] != rows->total) throw std::runtime_error("HDF5: dataset " + name + " has the wrong size");
+  const hsize_t first = rows->first, last = rows->last;
   values.resize(last - first, zero_value<T>());
   if (values.empty()) return;
   const hsize_t start[2] = {first, 0}, count[2] = {last - first, dims[1]};
@@ -318,6 +322,14 @@ std::vector<FieldLayout> field_layouts(int dimension) { return dimension == 3 ? 
 
 namespace {
 
+/// Calls write(particles, comm) with the particles this process writes: the store in one process; across ranks,
+/// this rank's run of ids (share_in_id_order), so that the file is the one a single process writes. Collective.
+template <int D, class Write>
+auto with_rows_in_id_order(const ParticleStore<D>& store, const par::Comm* comm, Write&& write) {
+  if (comm != nullptr && comm->distributed()) return write(share_in_id_order(store, *comm), comm);
+  return write(store, nullptr);
+}
+
 /// A frame of the store's fluid and walls in id order: with `comm`, this rank's rows of it (its run of ids).
 template <int D>
 FrameHeader write_frame_rows(const std::filesystem::path& file, const std::string& group, const ParticleStore<D>& store,
@@ -354,11 +366,9 @@ FrameHeader write_frame(const std::filesystem::path& file, const std::string& gr
                         double time, std::uint64_t step, std::uint64_t index, const std::vector<std::string>& fields,
                         const par::Comm* comm) {
   quiet_hdf5();
-  if (comm != nullptr && comm->distributed()) {  // each rank writes a run of ids, in id order after the lower ranks'
-    const ParticleStore<D> share = share_in_id_order(store, *comm);
-    return write_frame_rows(file, group, share, time, step, index, fields, comm);
-  }
-  return write_frame_rows(file, group, store, time, step, index, fields, nullptr);
+  return with_rows_in_id_order(store, comm, [&](const ParticleStore<D>& rows, const par::Comm* c) {
+    return write_frame_rows(file, group, rows, time, step, index, fields, c);
+  });
 }
 
 FrameHeader read_frame_header(const std::filesystem::path& file, const std::string& group) {
@@ -434,11 +444,9 @@ template <int D>
 void write_checkpoint(const std::filesystem::path& file, const ParticleStore<D>& store, const CheckpointState& state,
                       const par::Comm* comm) {
   quiet_hdf5();
-  if (comm != nullptr && comm->distributed()) {  // as a frame: each rank a run of ids, the file the one-process file
-    write_checkpoint_rows(file, share_in_id_order(store, *comm), state, comm);
-  } else {
-    write_checkpoint_rows(file, store, state, nullptr);
-  }
+  with_rows_in_id_order(store, comm, [&](const ParticleStore<D>& rows, const par::Comm* c) {
+    write_checkpoint_rows(file, rows, state, c);
+  });
 }
 
 std::string checkpoint_problem(const std::filesystem::path& file) {
@@ -503,23 +511,22 @@ CheckpointState read_checkpoint(const std::filesystem::path& file, ParticleStore
   s.scene = read_string_attribute(g, "scene");
   const auto n = read_attribute<std::uint64_t>(g, "particles", H5T_NATIVE_UINT64);
   store.clear();
-  if (comm == nullptr || !comm->distributed()) {
-    store.for_each_field([&](auto& field) {
-      read_dataset(g, std::string(field.name()), field.values());
-      if (field.size() != n) throw std::runtime_error(file.string() + ": field " + std::string(field.name()) + " has the wrong size");
-    });
-    store.set_next_id(s.next_id);
-    return s;
+  // This process's rows: all of them, or across ranks this rank's slab.
+  const bool shared = comm != nullptr && comm->distributed();
+  const auto r = shared ? static_cast<hsize_t>(comm->rank()) : 0, p = shared ? static_cast<hsize_t>(comm->size()) : 1;
+  const Rows rows{n * r / p, n * (r + 1) / p, n};
+  try {
+    store.for_each_field([&](auto& field) { read_dataset(g, std::string(field.name()), field.values(), rows); });
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(file.string() + ": " + e.what());
   }
-  // This rank's slab; then every slab's wall particles on every rank (in rank order, which is id order).
-  const auto r = static_cast<hsize_t>(comm->rank()), p = static_cast<hsize_t>(comm->size());
-  const std::pair<hsize_t, hsize_t> rows{n * r / p, n * (r + 1) / p};
-  store.for_each_field([&](auto& field) { read_dataset(g, std::string(field.name()), field.values(), rows); });
-  std::vector<std::byte> walls;
-  for (std::size_t i = 0; i < store.size(); ++i)
-    if (store.kind[i] == Kind::wall) pack_particle(store, i, walls);
-  store.compact([&](std::size_t i) { return store.kind[i] != Kind::wall; });
-  unpack_particles(store, comm->all_gather(walls));
+  if (shared) {  // every slab's wall particles on every rank (in rank order, which is id order)
+    std::vector<std::byte> walls;
+    for (std::size_t i = 0; i < store.size(); ++i)
+      if (store.kind[i] == Kind::wall) pack_particle(store, i, walls);
+    store.compact([&](std::size_t i) { return store.kind[i] != Kind::wall; });
+    unpack_particles(store, comm->all_gather(walls));
+  }
   store.set_next_id(s.next_id);
   return s;
 }
