@@ -71,6 +71,7 @@ class PairSweep {
   PairSweep(FluidEffects fluid, WallEffects wall, double c0, Vec<D> gravity)
       : fluid_(std::move(fluid)), wall_(std::move(wall)), c0_(c0), gravity_(std::move(gravity)) {}
 
+
   /// Computes kick and kick_rho of every fluid particle, and a and drho of the due ones (others get zero),
   /// from the current state.
   SweepLimits operator()(ParticleView<D> s, const CellGrid<D>& grid, Activity act = {}) const {
@@ -93,6 +94,7 @@ class PairSweep {
           const bool due = bi >= act.active_bin;
           PairSums<D> acc;
           double mu_max = 0.0;
+          double grad_mass = 0.0;  // sum_j m_j |grad W_ij| over the fluid and ghost pairs: the acoustic stiffness
           std::size_t pairs = 0, candidates = 0;
           Pair<D> pr;
           pr.i = i;
@@ -146,7 +148,9 @@ class PairSweep {
               // 2^-b_ij scales every fluid pair term (each is linear in grad W); a power of two, so exact.
               pr.weight = kBinWeight[static_cast<std::size_t>(bij)];
               const double inv_hij = s.h[j] == hi ? inv_hi : 1.0 / pr.hij;
-              pr.gradW = (pr.weight * Kernel::gradient_factor_inv(pr.r, inv_hij)) * xij;
+              const double factor = Kernel::gradient_factor_inv(pr.r, inv_hij);
+              pr.gradW = (pr.weight * factor) * xij;
+              grad_mass += s.m[j] * std::abs(factor) * pr.r;
               pr.mu = pr.hij * pr.vx / (r2 + 0.01 * pr.hij * pr.hij);
               std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, fluid_);
               mu_max = std::max(mu_max, std::abs(pr.mu));
@@ -167,7 +171,9 @@ class PairSweep {
           s.drho[i] = scale * acc.drho;
           const double an = s.a[i].norm();
           lim.dt_force = an > 0.0 ? scale * std::sqrt(hi / an) : inf;
-          lim.dt_cfl = scale * (hi / (c0_ + mu_max));
+          // h_i / (c0 + max mu), with h_i shortened where the neighbours are stiffer than i's own lattice
+          // (LatticeGradientSum::acoustic_length; docs/METHOD.md, "Time step and three refinement levels").
+          lim.dt_cfl = scale * (lattice_.acoustic_length(hi, s.d[i], s.rho[i], grad_mass) / (c0_ + mu_max));
           lim.finest_bin = bi;
           return lim;
         },
@@ -175,6 +181,7 @@ class PairSweep {
   }
 
  private:
+  LatticeGradientSum<D> lattice_;
   FluidEffects fluid_;
   WallEffects wall_;
   double c0_;

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -62,6 +63,74 @@ TEST(Kernel, GradientFactorTimesRIsTheDerivative) {
       const double ref3 = CubicSpline<3>::derivative(r, h) / r;
       EXPECT_NEAR(CubicSpline<3>::gradient_factor(r, h), ref3, 1e-13 * std::abs(CubicSpline<3>::norm(h)) / (h * h));
     }
+}
+
+// The lattice gradient sum kappa(h / d) = h sum_j d^D |grad W(x_j)| is a Riemann sum of h integral |grad W| dV
+// (= integral over the unit-h support of |dW/dq| in shells), taken here by the midpoint rule in q.
+template <int D>
+double gradient_integral() {
+  const int n = 400000;
+  double sum = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const double q = (k + 0.5) * 2.0 / n;
+    const double shell = D == 2 ? 2.0 * std::numbers::pi * q : 4.0 * std::numbers::pi * q * q;
+    sum += std::abs(CubicSpline<D>::derivative(q, 1.0)) * shell * (2.0 / n);
+  }
+  return sum;
+}
+
+TEST(Kernel, LatticeGradientSumTendsToTheIntegralOnFineLattices) {
+  // A lattice sum of a function with a kink (q = 1) and a cusp at the origin, which the sum leaves out: its error
+  // is O((d / h)^2) of the integral, (1/8)^2 = 1.6 % at h = 8 d; hence 2 %.
+  EXPECT_NEAR(CubicSpline<2>::lattice_gradient_sum(8.0) / gradient_integral<2>(), 1.0, 0.02);
+  EXPECT_NEAR(CubicSpline<3>::lattice_gradient_sum(8.0) / gradient_integral<3>(), 1.0, 0.02);
+}
+
+TEST(Kernel, LatticeGradientSumAtThePapersSpacing) {
+  // h = 1.2 d: the neighbours at distance 1 (4), sqrt 2 (4), 2 (4) and sqrt 5 (8) in 2D, summed here by hand.
+  const double h = 1.2;
+  double by_hand = 0.0;
+  for (const auto& [r, count] : {std::pair{1.0, 4}, {std::sqrt(2.0), 4}, {2.0, 4}, {std::sqrt(5.0), 8}}) {
+    by_hand += count * std::abs(CubicSpline<2>::derivative(r, h));
+  }
+  EXPECT_NEAR(CubicSpline<2>::lattice_gradient_sum(h), by_hand * h, 1e-14 * by_hand * h);
+  EXPECT_NEAR(CubicSpline<2>::lattice_gradient_sum(h), 1.9641, 1e-4);  // the value docs/METHOD.md quotes
+}
+
+template <int D>
+void check_table() {
+  // Linear interpolation between nodes dx apart errs by at most dx^2 / 8 max |kappa''| over the interval. The
+  // second derivative is bounded here from second differences of the sum itself on a grid 20x finer (kappa is
+  // piecewise smooth: a shell entering the support at q = 2 does so with zero value and slope).
+  const sph::LatticeGradientSum<D> t;
+  const double dx = sph::LatticeGradientSum<D>::kStep, e = dx / 20.0;
+  for (double hd = 0.6; hd < 3.9; hd += 0.0137) {
+    const double lo = sph::LatticeGradientSum<D>::kFirst + dx * std::floor((hd - sph::LatticeGradientSum<D>::kFirst) / dx);
+    double curvature = 0.0;
+    for (double y = lo; y <= lo + dx + 1e-12; y += e) {
+      const double k2 = (CubicSpline<D>::lattice_gradient_sum(y + e) - 2.0 * CubicSpline<D>::lattice_gradient_sum(y) +
+                         CubicSpline<D>::lattice_gradient_sum(y - e)) / (e * e);
+      curvature = std::max(curvature, std::abs(k2));
+    }
+    const double bound = dx * dx / 8.0 * curvature * 1.05 + 1e-13;  // 5 %: the finite-difference estimate's own error
+    EXPECT_NEAR(t(hd), CubicSpline<D>::lattice_gradient_sum(hd), bound) << "h / d = " << hd;
+  }
+}
+
+TEST(Kernel, TabulatedLatticeGradientSumFollowsTheSum) {
+  check_table<2>();
+  check_table<3>();
+}
+
+TEST(Kernel, AcousticLengthIsHOnTheLatticeAndShorterWhereStiffer) {
+  const sph::LatticeGradientSum<2> t;
+  const double d = 0.5, h = 1.2 * d, rho = 1000.0;
+  // The particle's own lattice: m_j = rho d^2 and sum_j d^2 |grad W_ij| = kappa / h, so the length is h.
+  const double lattice_mass = rho * CubicSpline<2>::lattice_gradient_sum(1.2) / h;  // = m sum_j |grad W_ij|
+  EXPECT_NEAR(t.acoustic_length(h, d, rho, lattice_mass), h, 1e-4 * h);
+  EXPECT_DOUBLE_EQ(t.acoustic_length(h, d, rho, 0.5 * lattice_mass), h);  // a free surface: never longer than h
+  EXPECT_NEAR(t.acoustic_length(h, d, rho, 2.0 * lattice_mass), 0.5 * h, 1e-4 * h);
+  EXPECT_DOUBLE_EQ(t.acoustic_length(h, d, rho, 0.0), h);  // an isolated particle
 }
 
 TEST(Kernel, CompactSupport) {

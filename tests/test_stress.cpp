@@ -220,9 +220,9 @@ const StressCase kCases[] = {
      true},
     // Short form in a 30 m tank (the obstacle 5 m from the column), through the impact: the refinement reaches
     // level 2 at the surge front (from t ~ 0.35 s) before it strikes the obstacle's foot (t ~ 0.55 s) and runs
-    // up it. The scene runs at time.cfl 0.1: at 0.2 this same short form gains 18 kJ/m (1.3e-4 of E_scale)
-    // while the level-2 front reaches the obstacle's corner (t = 0.57 .. 0.61 s), past kEnergyRise; at 0.1 it
-    // does not (the scene file says why).
+    // up it. At time.cfl 0.2 with the time step's old acoustic limit (h_i / c0, blind to squeezed daughters) this
+    // short form gained 18 kJ/m (1.3e-4 of E_scale) while the level-2 front reached the obstacle's corner
+    // (t = 0.57 .. 0.61 s), past kEnergyRise; the scene file says why.
     {"dam_break_obstacle_3levels.json", {"container.hi=[30,80]", "probes[1].x=30"}, 1.0, 0.3, 0.25,
      "surge at ~25 m/s striking the obstacle with c0 = 221 m/s (water hammer v / c0 = 0.11), then the jet thrown up "
      "the obstacle's face at up to 86 m/s (measured; v / c0 = 0.39 for its fastest particles): measured 0.18; "

@@ -6,7 +6,7 @@ thread), and stores its time series (time, step, mass and the probe columns) as
 tests/data/case_references/<case>.csv, with a header naming the command and the commit. The test runs each
 case to a fraction of its end time and compares the probes with these rows.
 
-    /usr/bin/python3 tools/case_references.py [case ...]     (default: every case)
+    /usr/bin/python3 tools/case_references.py [case ...]     (default: every case; SPH_APP=binary to use another build)
 """
 import csv
 import glob
@@ -15,7 +15,8 @@ import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-APP = os.path.join(ROOT, "build", "release", "app", "sphrefine")
+# SPH_APP names another sphrefine binary (the mpi preset's, which runs one process as the release build does).
+APP = os.environ.get("SPH_APP", os.path.join(ROOT, "build", "release", "app", "sphrefine"))
 OUT = os.path.join(ROOT, "tests", "data", "case_references")
 RUNS = os.path.join(ROOT, "results", "case_references")
 KEEP = ("time", "step", "fluid", "mass")  # plus every probe column (those after max_density_error)

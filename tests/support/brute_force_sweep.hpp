@@ -50,6 +50,7 @@ ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<
   ref.a_scale.assign(n, 0.0);
   const Vec<D> g = st.gravity.value_or(Vec<D>::Zero());
   const double c = st.eos.c0;
+  const sph::LatticeGradientSum<D> lattice;
   const auto bin = [&](std::size_t k) { return std::min(static_cast<int>(s.level[k]), act.bin_cap); };
   for (std::size_t i = 0; i < n; ++i) {
     if (s.kind[i] != Kind::fluid) continue;
@@ -57,7 +58,7 @@ ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<
     const bool due = bi >= act.active_bin;
     const double wi = std::pow(2.0, -bi);
     Vec<D> ai = due ? Vec<D>(wi * g) : Vec<D>(Vec<D>::Zero());
-    double scale = g.norm(), drho = 0.0, drho_scale = 0.0, mu_max = 0.0;
+    double scale = g.norm(), drho = 0.0, drho_scale = 0.0, mu_max = 0.0, grad_mass = 0.0;
     for (std::size_t j = 0; j < n; ++j) {
       if (j == i) continue;
       const Vec<D> xij = s.x[i] - s.x[j];
@@ -80,6 +81,7 @@ ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<
       const double w = std::pow(2.0, -bij);
       const double hij = 0.5 * (s.h[i] + s.h[j]);
       const Vec<D> gradW = r > 0.0 ? Vec<D>(w * K::derivative(r, hij) * xij / r) : Vec<D>(Vec<D>::Zero());
+      grad_mass += s.m[j] * std::abs(K::derivative(r, hij));  // the acoustic limit's stiffness, unweighted
       // Near the edge of the support grad W goes as (2 - q)^2, so an ulp of q (the sweep forms q = r (1/h_ij),
       // this r / h_ij) moves the term by 2 q / (2 - q) ulps: the term's share of the scale carries that factor.
       // (With many neighbours other terms dominate the scale; a particle whose only due pair sits at the edge
@@ -124,7 +126,9 @@ ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<
     ref.a[i] = up * ai;
     ref.drho[i] = up * drho;
     if (ai.norm() > 0.0) ref.dt_force = std::min(ref.dt_force, up * std::sqrt(s.h[i] / ref.a[i].norm()));
-    ref.dt_cfl = std::min(ref.dt_cfl, up * s.h[i] / (c + mu_max));
+    // The acoustic length: h_i, or kappa(h_i / d_i) rho_i / sum_j m_j |grad W_ij| where shorter (kernel.hpp).
+    const double length = grad_mass > 0.0 ? std::min(s.h[i], lattice(s.h[i] / s.d[i]) * s.rho[i] / grad_mass) : s.h[i];
+    ref.dt_cfl = std::min(ref.dt_cfl, up * length / (c + mu_max));
   }
   return ref;
 }
