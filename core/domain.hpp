@@ -137,7 +137,7 @@ class DomainT {
     std::unordered_map<std::uint64_t, double> weight;
     for (std::size_t i = 0; i < store.size(); ++i) {
       if (store.kind[i] != Kind::fluid) continue;
-      weight[key_of(store.x[i])] += static_cast<double>(1u << integ.bin(store.level[i]));
+      weight[key_of(store.x[i])] += static_cast<double>(1u << integ.bin(store.bin[i]));
     }
     std::vector<std::uint64_t> keys;
     keys.reserve(weight.size());
@@ -321,7 +321,7 @@ class DomainT {
     std::vector<double> w(static_cast<std::size_t>(comm_.size()), 0.0);
     for (std::size_t i = 0; i < store.size(); ++i) {
       if (store.kind[i] == Kind::fluid)
-        w[static_cast<std::size_t>(owner_of(store.x[i]))] += static_cast<double>(1u << integ.bin(store.level[i]));
+        w[static_cast<std::size_t>(owner_of(store.x[i]))] += static_cast<double>(1u << integ.bin(store.bin[i]));
     }
     std::vector<double> total(w.size(), 0.0);
     const std::vector<double> all = comm_.all_gather_values(w);

@@ -4,8 +4,9 @@
 // component says what each particle does in them, and which pairs each evaluation must cover.
 //
 // One step advances the fluid by dt0 in K = 2^B substeps of tau = dt0 / K, B the finest bin present. Particle
-// i is in bin b_i = min(level_i, bin_cap) (bin_cap = 0: one global step) and is due every 2^(B - b_i)
-// substeps; a pair steps at its finer member's rate, b_ij = max(b_i, b_j). The step is:
+// i is in bin b_i (the store's `bin`: at least its level, finer where its own time-step limit asks, bin_for;
+// 0 with one global step) and is due every 2^(B - b_i) substeps; a pair steps at its finer member's rate,
+// b_ij = max(b_i, b_j). The step is:
 //   open:   vh = v + (dt0 2^-b / 2) a,  rhoh = rho + (dt0 2^-b / 2) drho       (a, drho: the last rates)
 //   for k = 1..K:
 //     drift:   x += tau vh for every fluid particle, and the prediction where it is needed:
@@ -13,6 +14,10 @@
 //     forces:  the pairs with b_ij >= the active bin of substep k (core/sweep.hpp), each weighted by 2^-b_ij
 //     kick:    k < K:  vh += dt0 kick, rhoh += dt0 kick_rho  (a closing and an opening half-kick at once)
 //              k = K:  v = vh + (dt0 / 2) kick, rho = rhoh + (dt0 / 2) kick_rho  (every pair closes)
+// Bins change between steps only. Before the last evaluation each particle's next bin is chosen (bin_for); where
+// any changes, that evaluation sums every pair twice, with this step's weights for the closing kick and with the
+// next step's for the rates a and drho that open it (Activity::rebin), so each pair's closing and opening
+// impulses are equal and opposite in both members whatever the bins do.
 // This is a multiple-time-step leapfrog split by pairs (r-RESPA): every pair impulse is applied to both
 // members at the same instant, equal and opposite and along x_ij, so linear and angular momentum are exact to
 // rounding whatever the bins. With bin_cap = 0 (B = 0, K = 1) it is, operation for operation, the single-rate
@@ -22,9 +27,11 @@
 // Coarse particles take their own pairs' forces once per coarse step; the pairs they share with finer ones are
 // evaluated at the finer rate, from both sides. Steps end with every bin synchronised, so refinement,
 // coarsening, output and checkpoints only ever see synchronised particles.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "core/equation_of_state.hpp"
 #include "core/particle_store.hpp"
@@ -43,7 +50,32 @@ class Integrator {
 
   TimeStepping mode() const { return mode_; }
   int bin_cap() const { return mode_ == TimeStepping::global ? 0 : kMaxBin; }
-  int bin(std::int32_t level) const { return Activity{0, bin_cap()}.bin(level); }
+  int bin(std::int32_t b) const { return Activity{0, bin_cap()}.bin(b); }
+
+  /// The candidate shares of the target step (below): 2^(-k/8), k = 0..8.
+  static constexpr int kShrinks = 9;
+  static double shrink(int k) { return std::exp2(-0.125 * static_cast<double>(k)); }
+
+  /// The coarse step the levels alone would allow: cfl times the smallest 2^level_i times particle i's limit
+  /// without its acoustic stiffness (dt_limit_i s_i: its acoustic limit at h_i, or its force limit if that is
+  /// shorter, which this overestimates, and the bins below then catch). Infinite before any evaluation.
+  template <int D>
+  double level_target(const ParticleView<D>& s, std::size_t i, double cfl) const {
+    if (s.kind[i] != Kind::fluid || !(s.dt_limit[i] > 0.0)) return std::numeric_limits<double>::infinity();
+    return cfl * std::ldexp(s.dt_limit[i] * std::max(1.0, s.stiffness[i]), bin(s.level[i]));
+  }
+
+  /// The bin particle i steps in when the coarse step is dt0: its level's, or the fewest bins finer whose step
+  /// dt0 / 2^b is within cfl times its own limit dt_limit_i (force and acoustic, from its last evaluation). With
+  /// one global step, or before any evaluation, its level's (0 with one global step).
+  template <int D>
+  int bin_for(const ParticleView<D>& s, std::size_t i, double dt0, double cfl) const {
+    int b = bin(s.level[i]);
+    if (bin_cap() == 0 || !(s.dt_limit[i] > 0.0) || !std::isfinite(dt0)) return b;
+    const double allowed = cfl * s.dt_limit[i];
+    while (b < bin_cap() && std::ldexp(dt0, -b) > allowed) ++b;
+    return b;
+  }
 
   /// The pairs the evaluation after substep k (1..2^finest) covers: those of the bins due at t_k.
   Activity activity(int k, int finest) const {
@@ -57,7 +89,7 @@ class Integrator {
   /// Opening half-kick of a step of dt0 (fluid particles only).
   template <int D>
   void open(const ParticleView<D>& s, std::size_t i, double dt0) const {
-    const double half = (0.5 * dt0) * kBinWeight[static_cast<std::size_t>(bin(s.level[i]))];
+    const double half = (0.5 * dt0) * kBinWeight[static_cast<std::size_t>(bin(s.bin[i]))];
     s.vh[i] = s.v[i] + half * s.a[i];
     s.rhoh[i] = s.rho[i] + half * s.drho[i];
   }
@@ -66,7 +98,7 @@ class Integrator {
   template <int D>
   void drift(const ParticleView<D>& s, std::size_t i, double tau, int k, int finest) const {
     s.x[i] += tau * s.vh[i];
-    const int period = 1 << (finest - bin(s.level[i]));  // substeps per step of i's bin
+    const int period = 1 << (finest - bin(s.bin[i]));  // substeps per step of i's bin
     const int start = ((k - 1) / period) * period;       // substep at which i's current step began
     const double offset = static_cast<double>(2 * (k - start) - period) * (0.5 * tau);  // t_k - t_mid
     s.v[i] = s.vh[i] + offset * s.a[i];

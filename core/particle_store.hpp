@@ -35,6 +35,10 @@ struct ParticleView {
   Origin* origin = nullptr;
   Vec<D>* kick = nullptr;
   double* kick_rho = nullptr;
+  std::int32_t* bin = nullptr;
+  std::int32_t* next_bin = nullptr;
+  double* stiffness = nullptr;
+  double* dt_limit = nullptr;
 };
 
 template <int D>
@@ -68,6 +72,15 @@ class ParticleStore {
   // a and drho with one global step; with time bins they hold only the pairs due at the current substep.
   Field<VecD> kick{"kick_rate", "m/s^2"};
   Field<double> kick_rho{"kick_density_rate", "kg/m^3/s"};
+  // Time bins (core/integrator.hpp): the particle steps dt0 / 2^bin this step; next_bin is the bin of the next
+  // step, chosen before the step's last evaluation (Simulation::choose_bins) from the particle's own time-step
+  // limit dt_limit (min of its force and acoustic limits, unscaled) and its acoustic stiffness h_i / L_i >= 1
+  // (core/kernel.hpp, LatticeGradientSum::acoustic_length), both from its last evaluation. Bins are 0 with one
+  // global step.
+  Field<std::int32_t> bin{"time_bin", "1"};
+  Field<std::int32_t> next_bin{"next_time_bin", "1"};
+  Field<double> stiffness{"acoustic_stiffness", "1"};
+  Field<double> dt_limit{"time_step_limit", "s"};
 
   /// The registry: every field as a pointer to member. Adding a field above and here is all it takes for
   /// every operation (gather, compaction, expansion, copies, output, checkpoints) to carry it.
@@ -76,7 +89,9 @@ class ParticleStore {
                            &ParticleStore::m, &ParticleStore::h, &ParticleStore::d, &ParticleStore::level,
                            &ParticleStore::kind, &ParticleStore::id, &ParticleStore::drho, &ParticleStore::a,
                            &ParticleStore::vh, &ParticleStore::rhoh, &ParticleStore::level_time,
-                           &ParticleStore::origin, &ParticleStore::kick, &ParticleStore::kick_rho);
+                           &ParticleStore::origin, &ParticleStore::kick, &ParticleStore::kick_rho,
+                           &ParticleStore::bin, &ParticleStore::next_bin, &ParticleStore::stiffness,
+                           &ParticleStore::dt_limit);
   }
 
   /// Visits every field. f is called with each Field<T>&.
@@ -177,7 +192,7 @@ class ParticleStore {
   ParticleView<D> view() {
     return {size(), x.data(), v.data(), rho.data(), p.data(), m.data(), h.data(), d.data(),
             level.data(), kind.data(), id.data(), drho.data(), a.data(), vh.data(), rhoh.data(), level_time.data(),
-            origin.data(), kick.data(), kick_rho.data()};
+            origin.data(), kick.data(), kick_rho.data(), bin.data(), next_bin.data(), stiffness.data(), dt_limit.data()};
   }
 
   /// Bytes held by every field (data and scratch), for memory reports.
@@ -189,7 +204,7 @@ class ParticleStore {
 
   /// Bytes one particle occupies across all fields.
   static constexpr std::size_t bytes_per_particle() {
-    return 5 * sizeof(VecD) + 9 * sizeof(double) + sizeof(std::int32_t) + sizeof(Kind) + sizeof(ParticleId) +
+    return 5 * sizeof(VecD) + 11 * sizeof(double) + 3 * sizeof(std::int32_t) + sizeof(Kind) + sizeof(ParticleId) +
            sizeof(Origin);
   }
 

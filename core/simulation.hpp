@@ -161,6 +161,9 @@ class SimulationT {
   Activity activity(int k, int finest);
   /// Adds a finished step's work (finest bin, summed limits of its sweeps) to work_.
   void count_work(int finest, const SweepLimits& lim);
+  /// Sets every fluid particle's next_bin (Integrator::bin_for) for the coarse step the cheapest of the
+  /// candidate shares of the levels' target step gives; true where any differs from its bin (on any rank).
+  bool choose_bins();
   /// How many entries particle i has in the expanded set: ghosts 0, walls 1, fluid 1 + its images.
   std::uint32_t output_count(const ParticleView<D>& view, std::size_t i) const;
   /// prepare_neighbours() from its second pass on: expand_offsets_[0..n) holds the output counts and hr the

@@ -182,6 +182,11 @@ void SimulationT<D>::refresh() {
   par::parallel_for(s.n, [&](std::size_t i) {
     if (s.kind[i] == Kind::fluid) s.p[i] = eos.pressure(s.rho[i]);
   });
+  // Levels may have changed (a split or a merge): each particle's bin again, before the rates are evaluated.
+  choose_bins();
+  par::parallel_for(s.n, [&](std::size_t i) {
+    if (s.kind[i] == Kind::fluid) s.bin[i] = s.next_bin[i];
+  });
   prepare_neighbours();
   limits_ = global(sweep_->run(store_.view(), grid_, integrator_.activity(1, 0)));
   dt_ = next_dt();
@@ -200,13 +205,66 @@ void SimulationT<D>::count_work(int finest, const SweepLimits& lim) {
   std::array<std::uint64_t, Work::kLevels> per_level{};
   const auto s = store_.view();
   for (std::size_t i = 0; i < s.n; ++i)
-    if (s.kind[i] == Kind::fluid) ++per_level[static_cast<std::size_t>(std::min(s.level[i], Work::kLevels - 1))];
-  for (int l = 0; l < Work::kLevels; ++l)
-    work_.evaluations[static_cast<std::size_t>(l)] +=
-        per_level[static_cast<std::size_t>(l)] << integrator_.bin(l);
+    if (s.kind[i] == Kind::fluid)
+      per_level[static_cast<std::size_t>(std::min(s.level[i], Work::kLevels - 1))] += 1u << integrator_.bin(s.bin[i]);
+  for (int l = 0; l < Work::kLevels; ++l) work_.evaluations[static_cast<std::size_t>(l)] += per_level[static_cast<std::size_t>(l)];
   work_.pairs += lim.pairs;
   work_.candidates += lim.candidates;
   work_.substeps += 1u << finest;
+}
+
+template <int D>
+bool SimulationT<D>::choose_bins() {
+  const auto s = store_.view();
+  const Integrator& integ = integrator_;
+  const double cfl = settings_.cfl;
+  if (integ.bin_cap() == 0) {
+    par::parallel_for(s.n, [&](std::size_t i) { s.next_bin[i] = 0; });
+    return false;
+  }
+  // The levels' target step, then for each candidate share of it the evaluations a coarse step would take
+  // (sum of 2^bin): the cheapest per unit of time wins. Integers and an exact min: the same at any thread and
+  // rank count.
+  double target = par::reduce(
+      s.n, std::numeric_limits<double>::infinity(), [&](std::size_t i) { return integ.level_target(s, i, cfl); },
+      [](double a, double b) { return std::min(a, b); });
+  if (domain_) target = -domain_->comm().max(-target);
+  target = std::min(target, settings_.dt_max);
+  using Costs = std::array<std::uint64_t, Integrator::kShrinks>;
+  Costs cost = par::reduce(
+      s.n, Costs{},
+      [&](std::size_t i) {
+        Costs c{};
+        if (s.kind[i] != Kind::fluid) return c;
+        for (int k = 0; k < Integrator::kShrinks; ++k) {
+          c[static_cast<std::size_t>(k)] = std::uint64_t{1} << integ.bin_for(s, i, target * Integrator::shrink(k), cfl);
+        }
+        return c;
+      },
+      [](Costs a, const Costs& b) {
+        for (std::size_t k = 0; k < a.size(); ++k) a[k] += b[k];
+        return a;
+      });
+  if (domain_) {
+    for (auto& c : cost) c = domain_->comm().sum(c);
+  }
+  int best = 0;
+  for (int k = 1; k < Integrator::kShrinks; ++k) {
+    const auto ck = static_cast<double>(cost[static_cast<std::size_t>(k)]) / Integrator::shrink(k);
+    const auto cb = static_cast<double>(cost[static_cast<std::size_t>(best)]) / Integrator::shrink(best);
+    if (ck < cb) best = k;
+  }
+  const double dt0 = target * Integrator::shrink(best);
+  bool changed = par::reduce(
+      s.n, false,
+      [&](std::size_t i) {
+        if (s.kind[i] != Kind::fluid) return false;
+        s.next_bin[i] = integ.bin_for(s, i, dt0, cfl);
+        return s.next_bin[i] != s.bin[i];
+      },
+      [](bool a, bool b) { return a || b; });
+  if (domain_) changed = domain_->comm().any(changed);
+  return changed;
 }
 
 template <int D>
@@ -214,7 +272,7 @@ void SimulationT<D>::store_restored() {
   const auto s = store_.view();
   int finest = 0;
   for (std::size_t i = 0; i < s.n; ++i)
-    if (s.kind[i] == Kind::fluid) finest = std::max(finest, integrator_.bin(s.level[i]));
+    if (s.kind[i] == Kind::fluid) finest = std::max(finest, integrator_.bin(s.bin[i]));
   limits_.finest_bin = domain_ ? static_cast<int>(domain_->comm().max(static_cast<double>(finest))) : finest;
 }
 
@@ -225,7 +283,7 @@ Activity SimulationT<D>::activity(int k, int finest) {
   const auto s = store_.view();
   due_prefix_.resize(s.n + 1);
   par::parallel_for(s.n, [&](std::size_t i) {
-    due_prefix_[i] = s.kind[i] != Kind::wall && act.bin(s.level[i]) >= act.active_bin ? 1u : 0u;
+    due_prefix_[i] = s.kind[i] != Kind::wall && act.bin(s.bin[i]) >= act.active_bin ? 1u : 0u;
   });
   due_prefix_[s.n] = par::exclusive_scan(due_prefix_.data(), due_prefix_.data(), s.n);
   act.due_prefix = due_prefix_.data();
@@ -286,6 +344,8 @@ StepInfo SimulationT<D>::step(double dt_cap) {
     // that is reported (and undone) like any other failure of the step, naming the particle.
     // Distributed, the ranks agree on whether the substep failed before the next collective call, so that no rank
     // waits for one that has left the step.
+    // Before the last evaluation: each particle's bin for the next step (before the ghosts and halos copy it).
+    const bool rebin = k == substeps && integ.bin_cap() > 0 && choose_bins();
     SweepLimits lim;
     try {
       if (renumbered || domain_) {
@@ -293,7 +353,9 @@ StepInfo SimulationT<D>::step(double dt_cap) {
       } else {
         build_neighbours(hr);
       }
-      lim = sweep_->run(store_.view(), grid_, activity(k, finest));
+      Activity act = activity(k, finest);
+      act.rebin = rebin;
+      lim = sweep_->run(store_.view(), grid_, act);
     } catch (const std::exception& e) {
       if (!watch && !domain_) throw;
       step_error = e.what();
@@ -314,7 +376,9 @@ StepInfo SimulationT<D>::step(double dt_cap) {
   if (step_error.empty()) {
     auto s = store_.view();
     par::parallel_for(s.n, [&](std::size_t i) {
-      if (s.kind[i] == Kind::fluid) integ.kick(s, i, dt, true);
+      if (s.kind[i] != Kind::fluid) return;
+      integ.kick(s, i, dt, true);
+      s.bin[i] = s.next_bin[i];
     });
     limits_ = step_limits;
     count_work(finest, step_limits);

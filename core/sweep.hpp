@@ -55,14 +55,19 @@ inline constexpr auto kBinScale = [] {
 }();
 
 /// Which pairs a sweep evaluates: those whose bin max(b_i, b_j) is at least active_bin, with
-/// b_i = min(level_i, bin_cap). The default (0, 0) is the single-rate sweep: every pair, weight 1.
+/// b_i = min(bin_i, bin_cap) (the store's time bin). The default (0, 0) is the single-rate sweep: every pair,
+/// weight 1.
 struct Activity {
   int active_bin = 0;
   int bin_cap = 0;
+  // The last evaluation of a step in which some particle's bin changes (active_bin 0): kick and kick_rho take the
+  // pairs weighted by this step's bins (the closing kick), a, drho and the limits by next_bin's (the next step's
+  // opening kick and dt0).
+  bool rebin = false;
   // Optional, with active_bin > 0: due_prefix[k] counts the due particles (fluid or ghost, bin >= active_bin)
   // among the first k of the store. A particle that is not due skips every candidate run without one.
   const std::uint32_t* due_prefix = nullptr;
-  int bin(std::int32_t level) const { return level < bin_cap ? static_cast<int>(level) : bin_cap; }
+  int bin(std::int32_t b) const { return b < bin_cap ? static_cast<int>(b) : bin_cap; }
 };
 
 template <int D, class FluidEffects, class WallEffects>
@@ -90,9 +95,11 @@ class PairSweep {
             s.kick_rho[i] = 0.0;
             return lim;
           }
-          const int bi = act.bin(s.level[i]);
+          const int bi = act.bin(s.bin[i]);
+          const int nbi = act.rebin ? act.bin(s.next_bin[i]) : bi;
           const bool due = bi >= act.active_bin;
           PairSums<D> acc;
+          PairSums<D> next;  // with act.rebin: the sums weighted by the next bins
           double mu_max = 0.0;
           double grad_mass = 0.0;  // sum_j m_j |grad W_ij| over the fluid and ghost pairs: the acoustic stiffness
           std::size_t pairs = 0, candidates = 0;
@@ -136,23 +143,41 @@ class PairSweep {
               if (s.kind[j] == Kind::wall) {  // due, and within the wall effects' reach
                 ++pairs;
                 if constexpr (has_wall_effects) {
-                  pr.weight = kBinWeight[static_cast<std::size_t>(bi)];
-                  std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, wall_);
+                  if (!act.rebin) {
+                    pr.weight = kBinWeight[static_cast<std::size_t>(bi)];
+                    std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, wall_);
+                  } else {
+                    PairSums<D> one;
+                    pr.weight = 1.0;
+                    std::apply([&](const auto&... eff) { (eff(s, pr, one), ...); }, wall_);
+                    add_weighted(acc, one, bi);
+                    add_weighted(next, one, nbi);
+                  }
                 }
                 continue;
               }
-              const int bj = act.bin(s.level[j]);
+              const int bj = act.bin(s.bin[j]);
               const int bij = bi > bj ? bi : bj;
               if (bij < act.active_bin) continue;
               ++pairs;
-              // 2^-b_ij scales every fluid pair term (each is linear in grad W); a power of two, so exact.
-              pr.weight = kBinWeight[static_cast<std::size_t>(bij)];
               const double inv_hij = s.h[j] == hi ? inv_hi : 1.0 / pr.hij;
               const double factor = Kernel::gradient_factor_inv(pr.r, inv_hij);
-              pr.gradW = (pr.weight * factor) * xij;
               grad_mass += s.m[j] * std::abs(factor) * pr.r;
               pr.mu = pr.hij * pr.vx / (r2 + 0.01 * pr.hij * pr.hij);
-              std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, fluid_);
+              if (!act.rebin) {
+                // 2^-b_ij scales every fluid pair term (each is linear in grad W); a power of two, so exact.
+                pr.weight = kBinWeight[static_cast<std::size_t>(bij)];
+                pr.gradW = (pr.weight * factor) * xij;
+                std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, fluid_);
+              } else {  // the pair once at weight 1, then at this step's and at the next step's weight
+                const int nbj = act.bin(s.next_bin[j]);
+                PairSums<D> one;
+                pr.weight = 1.0;
+                pr.gradW = factor * xij;
+                std::apply([&](const auto&... eff) { (eff(s, pr, one), ...); }, fluid_);
+                add_weighted(acc, one, bij);
+                add_weighted(next, one, nbi > nbj ? nbi : nbj);
+              }
               mu_max = std::max(mu_max, std::abs(pr.mu));
             }
           }, holds_due);
@@ -163,24 +188,42 @@ class PairSweep {
             s.kick_rho[i] = acc.drho;
             return lim;
           }
-          const double scale = kBinScale[static_cast<std::size_t>(bi)];
           acc.a += kBinWeight[static_cast<std::size_t>(bi)] * gravity_;
           s.kick[i] = acc.a;
           s.kick_rho[i] = acc.drho;
-          s.a[i] = scale * acc.a;
-          s.drho[i] = scale * acc.drho;
+          // The rates and limits are those of the bin the particle opens its next step in.
+          const double scale = kBinScale[static_cast<std::size_t>(nbi)];
+          if (act.rebin) {
+            next.a += kBinWeight[static_cast<std::size_t>(nbi)] * gravity_;
+          } else {
+            next = acc;
+          }
+          s.a[i] = scale * next.a;
+          s.drho[i] = scale * next.drho;
           const double an = s.a[i].norm();
-          lim.dt_force = an > 0.0 ? scale * std::sqrt(hi / an) : inf;
+          const double own_force = an > 0.0 ? std::sqrt(hi / an) : inf;
           // h_i / (c0 + max mu), with h_i shortened where the neighbours are stiffer than i's own lattice
           // (LatticeGradientSum::acoustic_length; docs/METHOD.md, "Time step and three refinement levels").
-          lim.dt_cfl = scale * (lattice_.acoustic_length(hi, s.d[i], s.rho[i], grad_mass) / (c0_ + mu_max));
-          lim.finest_bin = bi;
+          const double length = lattice_.acoustic_length(hi, s.d[i], s.rho[i], grad_mass);
+          const double own_cfl = length / (c0_ + mu_max);
+          s.stiffness[i] = hi / length;
+          s.dt_limit[i] = std::min(own_force, own_cfl);
+          lim.dt_force = scale * own_force;
+          lim.dt_cfl = scale * own_cfl;
+          lim.finest_bin = nbi;
           return lim;
         },
         [](const SweepLimits& x, const SweepLimits& y) { return x.merged(y); });
   }
 
  private:
+  /// sum += 2^-b one: a power of two, so the scaling is exact.
+  static void add_weighted(PairSums<D>& sum, const PairSums<D>& one, int b) {
+    const double w = kBinWeight[static_cast<std::size_t>(b)];
+    sum.a += w * one.a;
+    sum.drho += w * one.drho;
+  }
+
   LatticeGradientSum<D> lattice_;
   FluidEffects fluid_;
   WallEffects wall_;

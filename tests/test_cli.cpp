@@ -181,7 +181,7 @@ TEST_F(Cli, ValidateAGoodSceneWritesNothing) {
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("scene OK: tiny"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("fluid particles    200"), std::string::npos) << r.out;
-  EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(\n  memory             about \d+ MiB \([\d,]+ particles at ~\d+ B each\) at the start, [\d.]+ GiB available\n)")))
+  EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(\n  memory             about \d+ MiB \([\d,]+ particles at ~(\d+ B|[\d.]+ kB) each\) at the start, [\d.]+ GiB available\n)")))
       << r.out;
   EXPECT_EQ(work_files(), std::vector<std::string>{"tiny.json"});
 }

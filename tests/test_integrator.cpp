@@ -114,13 +114,16 @@ TEST(Integrator, ThreeLevelCloudPerLevelConservesMomentumAndAngularMomentumOver1
   const std::uint64_t steps = test::short_runs() ? 200 : 1000;
   int substeps = 0;
   for (std::uint64_t k = 0; k < steps; ++k) substeps = std::max(substeps, sim.step().substeps);
-  EXPECT_EQ(substeps, 4) << "three levels step in four substeps";
-  // The work: level l is evaluated 2^l times a coarse step (nothing splits or merges here).
-  EXPECT_EQ(sim.work().evaluations[0], steps * n0);
-  EXPECT_EQ(sim.work().evaluations[1], 2 * steps * n1);
-  EXPECT_EQ(sim.work().evaluations[2], 4 * steps * n2);
-  EXPECT_EQ(sim.work().substeps, 4 * steps);
-  EXPECT_EQ(sim.fine_step_count(), 4 * steps);
+  // Level l steps in bin l or finer: finer where a particle's own limit asks (Integrator::bin_for; the AAP
+  // daughters at the level jumps, whose coarse neighbours are heavier, sum a stiffer neighbourhood than their
+  // lattice's), so bins change from step to step and the momentum checks below cover the steps that rebin.
+  EXPECT_GE(substeps, 4) << "three levels step in at least four substeps";
+  EXPECT_GE(sim.work().evaluations[0], steps * n0);
+  EXPECT_GE(sim.work().evaluations[1], 2 * steps * n1);
+  EXPECT_GE(sim.work().evaluations[2], 4 * steps * n2);
+  EXPECT_GT(sim.work().evaluations[2], 4 * steps * n2) << "some particles step finer than their level";
+  EXPECT_GE(sim.work().substeps, 4 * steps);
+  EXPECT_EQ(sim.fine_step_count(), sim.work().substeps);
   sim.remove_ghosts();
   const Totals m1 = totals(sim.store());
   EXPECT_EQ(m1.mass, m0.mass);

@@ -71,12 +71,13 @@ TEST(Sweep, TimeBinsEqualBruteForceIn3D) {
   sph::test::build_level_grid_in_order(s, grid);
   ASSERT_EQ(grid.layer_count(), 2);
   const auto sweep = sph::make_sweep(st);
+  for (std::size_t i = 0; i < s.size(); ++i) s.bin[i] = s.next_bin[i] = s.level[i];  // each level in its own bin
   for (const int active : {1, 0}) {
     SCOPED_TRACE(testing::Message() << "active bin " << active);
     sph::Activity act{active, sph::Integrator::kMaxBin};
     std::vector<std::uint32_t> prefix(s.size() + 1, 0);
     for (std::size_t i = 0; i < s.size(); ++i)
-      prefix[i + 1] = prefix[i] + (s.kind[i] != Kind::wall && act.bin(s.level[i]) >= active ? 1u : 0u);
+      prefix[i + 1] = prefix[i] + (s.kind[i] != Kind::wall && act.bin(s.bin[i]) >= active ? 1u : 0u);
     act.due_prefix = prefix.data();
     const sph::SweepLimits lim = sweep->run(s.view(), grid, act);
     expect_rates_match_brute_force(s, lim, st, "3D bins", act);

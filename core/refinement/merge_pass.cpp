@@ -172,6 +172,9 @@ MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::
     s.drho[k] = 0.0;
     s.kick[k].setZero();
     s.kick_rho[k] = 0.0;
+    // Its limits are not known until then: its bin is its level's (Integrator::bin_for).
+    s.stiffness[k] = 1.0;
+    s.dt_limit[k] = 0.0;
   });
   // Ghosts go too, as in the split pass: the solver rebuilds them for the new set.
   store.compact([&](std::size_t i) { return drop[i] == 0 && store.kind[i] != Kind::ghost; });

@@ -83,6 +83,10 @@ SplitResult split_marked(ParticleStore<D>& store, const std::vector<std::uint8_t
       s.id[k] = daughter_id<D>(parent, static_cast<unsigned>(a));
       s.level_time[k] = time;
       s.origin[k] = Origin::split;
+      // The parent's limits are not the daughters': until their first evaluation their bin is their level's
+      // (Integrator::bin_for), as for a merged particle.
+      s.stiffness[k] = 1.0;
+      s.dt_limit[k] = 0.0;
     }
   });
   return result;

@@ -32,10 +32,11 @@ struct ReferenceT {
 };
 using Reference = ReferenceT<2>;
 
-// With time bins (sph::Activity, core/sweep.hpp): a particle's bin is min(level, cap); a pair is evaluated
-// when the larger of its two bins is at least the active bin, its terms weighted by 2^-(that bin); gravity
-// and the wall terms belong to a due particle's own bin. `kick` holds the weighted sums; for a due particle,
-// a = 2^b kick and its limits are scaled by 2^b. The default activity is the single-rate sweep.
+// With time bins (sph::Activity, core/sweep.hpp): a particle's bin is min(bin, cap) (the store's time bin); a
+// pair is evaluated when the larger of its two bins is at least the active bin, its terms weighted by
+// 2^-(that bin); gravity and the wall terms belong to a due particle's own bin. `kick` holds the weighted
+// sums; for a due particle, a = 2^b kick and its limits are scaled by 2^b. With act.rebin the same with the
+// store's next_bin for a, drho and the limits (kick keeps bin). The default activity is the single-rate sweep.
 template <int D>
 ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<D>& st, sph::Activity act = {}) {
   using K = sph::CubicSpline<D>;
@@ -51,14 +52,18 @@ ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<
   const Vec<D> g = st.gravity.value_or(Vec<D>::Zero());
   const double c = st.eos.c0;
   const sph::LatticeGradientSum<D> lattice;
-  const auto bin = [&](std::size_t k) { return std::min(static_cast<int>(s.level[k]), act.bin_cap); };
+  const auto bin = [&](std::size_t k) { return std::min(static_cast<int>(s.bin[k]), act.bin_cap); };
+  const auto next_bin = [&](std::size_t k) {
+    return act.rebin ? std::min(static_cast<int>(s.next_bin[k]), act.bin_cap) : bin(k);
+  };
   for (std::size_t i = 0; i < n; ++i) {
     if (s.kind[i] != Kind::fluid) continue;
-    const int bi = bin(i);
+    const int bi = bin(i), nbi = next_bin(i);
     const bool due = bi >= act.active_bin;
-    const double wi = std::pow(2.0, -bi);
+    const double wi = std::pow(2.0, -bi), nwi = std::pow(2.0, -nbi);
     Vec<D> ai = due ? Vec<D>(wi * g) : Vec<D>(Vec<D>::Zero());
-    double scale = g.norm(), drho = 0.0, drho_scale = 0.0, mu_max = 0.0, grad_mass = 0.0;
+    Vec<D> next_ai = due ? Vec<D>(nwi * g) : Vec<D>(Vec<D>::Zero());  // weighted by the next bins
+    double scale = g.norm(), drho = 0.0, next_drho = 0.0, drho_scale = 0.0, mu_max = 0.0, grad_mass = 0.0;
     for (std::size_t j = 0; j < n; ++j) {
       if (j == i) continue;
       const Vec<D> xij = s.x[i] - s.x[j];
@@ -70,17 +75,19 @@ ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<
         if (r >= r0) continue;
         ++ref.pairs;
         if (r == 0.0) continue;
-        const Vec<D> f = wi * st.lennard_jones->strength * (std::pow(r0 / r, 12) - std::pow(r0 / r, 6)) * xij / (r * r);
-        ai += f;
-        scale += f.norm();
+        const Vec<D> f = st.lennard_jones->strength * (std::pow(r0 / r, 12) - std::pow(r0 / r, 6)) * xij / (r * r);
+        ai += wi * f;
+        next_ai += nwi * f;
+        scale += wi * f.norm();
         continue;
       }
       const int bij = std::max(bi, bin(j));
       if (bij < act.active_bin) continue;
       ++ref.pairs;
-      const double w = std::pow(2.0, -bij);
+      const double w = std::pow(2.0, -bij), nw = std::pow(2.0, -std::max(nbi, next_bin(j)));
       const double hij = 0.5 * (s.h[i] + s.h[j]);
-      const Vec<D> gradW = r > 0.0 ? Vec<D>(w * K::derivative(r, hij) * xij / r) : Vec<D>(Vec<D>::Zero());
+      // Every term is linear in grad W: summed at weight 1 here, then scaled by the pair's weights (powers of two).
+      const Vec<D> gradW = r > 0.0 ? Vec<D>(K::derivative(r, hij) * xij / r) : Vec<D>(Vec<D>::Zero());
       grad_mass += s.m[j] * std::abs(K::derivative(r, hij));  // the acoustic limit's stiffness, unweighted
       // Near the edge of the support grad W goes as (2 - q)^2, so an ulp of q (the sweep forms q = r (1/h_ij),
       // this r / h_ij) moves the term by 2 q / (2 - q) ulps: the term's share of the scale carries that factor.
@@ -96,8 +103,9 @@ ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<
         dr += 2.0 * st.density_diffusion->delta * hij * c * psi * xji.dot(gradW) / (r * r + 0.01 * hij * hij) *
               s.m[j] / s.rho[j];
       }
-      drho += dr;
-      drho_scale += cond * std::abs(dr);
+      drho += w * dr;
+      next_drho += nw * dr;
+      drho_scale += cond * std::abs(w * dr);
       double bracket = s.p[i] / (s.rho[i] * s.rho[i]) + s.p[j] / (s.rho[j] * s.rho[j]);  // eq. (6)
       const double mu = hij * vij.dot(xij) / (r * r + 0.01 * hij * hij);
       mu_max = std::max(mu_max, std::abs(mu));
@@ -113,8 +121,9 @@ ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<
         bracket += (Ri + Rj) * std::pow(f, st.artificial_stress->exponent);
       }
       const Vec<D> f = -s.m[j] * bracket * gradW;
-      ai += f;
-      scale += cond * f.norm();
+      ai += w * f;
+      next_ai += nw * f;
+      scale += cond * w * f.norm();
     }
     ref.kick[i] = ai;
     ref.kick_rho[i] = drho;
@@ -122,10 +131,10 @@ ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<
     ref.drho_scale[i] = drho_scale;
     if (!due) continue;
     ref.due[i] = 1;
-    const double up = std::pow(2.0, bi);
-    ref.a[i] = up * ai;
-    ref.drho[i] = up * drho;
-    if (ai.norm() > 0.0) ref.dt_force = std::min(ref.dt_force, up * std::sqrt(s.h[i] / ref.a[i].norm()));
+    const double up = std::pow(2.0, nbi);
+    ref.a[i] = up * next_ai;
+    ref.drho[i] = up * next_drho;
+    if (ref.a[i].norm() > 0.0) ref.dt_force = std::min(ref.dt_force, up * std::sqrt(s.h[i] / ref.a[i].norm()));
     // The acoustic length: h_i, or kappa(h_i / d_i) rho_i / sum_j m_j |grad W_ij| where shorter (kernel.hpp).
     const double length = grad_mass > 0.0 ? std::min(s.h[i], lattice(s.h[i] / s.d[i]) * s.rho[i] / grad_mass) : s.h[i];
     ref.dt_cfl = std::min(ref.dt_cfl, up * length / (c + mu_max));
@@ -156,9 +165,12 @@ void expect_rates_match_brute_force(const ParticleStore<D>& s, const sph::SweepL
         << what << ": kick_rho of " << i;
     if (ref.due[i] == 0) continue;  // a and drho of a particle that is not due are not the sweep's to write
     ++checked;
-    EXPECT_LE((s.a[i] - ref.a[i]).norm(), 1e-12 * std::pow(2.0, s.level[i]) * ref.a_scale[i] + 1e-300)
-        << what << ": a of " << i;
-    EXPECT_LE(std::abs(s.drho[i] - ref.drho[i]), 1e-12 * std::pow(2.0, s.level[i]) * ref.drho_scale[i] + 1e-300)
+    // a_scale sums the terms at this step's weights; the next bins' weights differ from them by at most
+    // 2^|next_bin - bin|, and a is scaled back by 2^next_bin.
+    const int b = act.rebin ? s.next_bin[i] : s.bin[i];
+    const double up = std::pow(2.0, b + std::abs(static_cast<int>(s.next_bin[i]) - static_cast<int>(s.bin[i])));
+    EXPECT_LE((s.a[i] - ref.a[i]).norm(), 1e-12 * up * ref.a_scale[i] + 1e-300) << what << ": a of " << i;
+    EXPECT_LE(std::abs(s.drho[i] - ref.drho[i]), 1e-12 * up * ref.drho_scale[i] + 1e-300)
         << what << ": drho of " << i;
   }
   EXPECT_GT(checked, act.active_bin == 0 ? 100u : 20u);
