@@ -222,39 +222,59 @@ bool SimulationT<D>::choose_bins() {
     par::parallel_for(s.n, [&](std::size_t i) { s.next_bin[i] = 0; });
     return false;
   }
-  // The levels' target step, then for each candidate share of it the evaluations a coarse step would take
-  // (sum of 2^bin): the cheapest per unit of time wins. Integers and an exact min: the same at any thread and
-  // rank count.
+  // The levels' target step, then for each candidate share of it what a coarse step would cost: the evaluations
+  // (sum of 2^bin over the fluid) and the substeps' own work (Integrator::kSubstepCost per fluid particle and
+  // substep, 2^(finest bin) substeps). The cheapest per unit of time wins. Integer sums and an exact min: the
+  // same at any thread and rank count.
   double target = par::reduce(
       s.n, std::numeric_limits<double>::infinity(), [&](std::size_t i) { return integ.level_target(s, i, cfl); },
       [](double a, double b) { return std::min(a, b); });
   if (domain_) target = -domain_->comm().max(-target);
   target = std::min(target, settings_.dt_max);
-  using Costs = std::array<std::uint64_t, Integrator::kShrinks>;
+  constexpr std::size_t K = Integrator::kShrinks;
+  std::array<double, K> candidate{};
+  for (std::size_t k = 0; k < K; ++k) candidate[k] = target * Integrator::shrink(static_cast<int>(k));
+  // Per candidate k: [k] the evaluations, [K + k] the finest bin; [2K] the fluid count.
+  using Costs = std::array<std::uint64_t, 2 * K + 1>;
   Costs cost = par::reduce(
       s.n, Costs{},
       [&](std::size_t i) {
         Costs c{};
         if (s.kind[i] != Kind::fluid) return c;
-        for (int k = 0; k < Integrator::kShrinks; ++k) {
-          c[static_cast<std::size_t>(k)] = std::uint64_t{1} << integ.bin_for(s, i, target * Integrator::shrink(k), cfl);
+        for (std::size_t k = 0; k < K; ++k) {
+          const int b = integ.bin_for(s, i, candidate[k], cfl);
+          c[k] = std::uint64_t{1} << b;
+          c[K + k] = static_cast<std::uint64_t>(b);
         }
+        c[2 * K] = 1;
         return c;
       },
       [](Costs a, const Costs& b) {
-        for (std::size_t k = 0; k < a.size(); ++k) a[k] += b[k];
+        for (std::size_t k = 0; k < K; ++k) {
+          a[k] += b[k];
+          a[K + k] = std::max(a[K + k], b[K + k]);
+        }
+        a[2 * K] += b[2 * K];
         return a;
       });
   if (domain_) {
-    for (auto& c : cost) c = domain_->comm().sum(c);
+    for (std::size_t k = 0; k < K; ++k) {
+      cost[k] = domain_->comm().sum(cost[k]);
+      cost[K + k] = static_cast<std::uint64_t>(domain_->comm().max(static_cast<double>(cost[K + k])));
+    }
+    cost[2 * K] = domain_->comm().sum(cost[2 * K]);
   }
-  int best = 0;
-  for (int k = 1; k < Integrator::kShrinks; ++k) {
-    const auto ck = static_cast<double>(cost[static_cast<std::size_t>(k)]) / Integrator::shrink(k);
-    const auto cb = static_cast<double>(cost[static_cast<std::size_t>(best)]) / Integrator::shrink(best);
-    if (ck < cb) best = k;
+  const auto per_time = [&](std::size_t k) {
+    const double evaluations = static_cast<double>(cost[k]);
+    const double substeps = static_cast<double>(std::uint64_t{1} << cost[K + k]);
+    return (evaluations + Integrator::kSubstepCost * static_cast<double>(cost[2 * K]) * substeps) /
+           Integrator::shrink(static_cast<int>(k));
+  };
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < K; ++k) {
+    if (per_time(k) < per_time(best)) best = k;
   }
-  const double dt0 = target * Integrator::shrink(best);
+  const double dt0 = candidate[best];
   bool changed = par::reduce(
       s.n, false,
       [&](std::size_t i) {

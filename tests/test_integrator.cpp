@@ -121,7 +121,14 @@ TEST(Integrator, ThreeLevelCloudPerLevelConservesMomentumAndAngularMomentumOver1
   EXPECT_GE(sim.work().evaluations[0], steps * n0);
   EXPECT_GE(sim.work().evaluations[1], 2 * steps * n1);
   EXPECT_GE(sim.work().evaluations[2], 4 * steps * n2);
-  EXPECT_GT(sim.work().evaluations[2], 4 * steps * n2) << "some particles step finer than their level";
+  // The bins change from step to step (so the checks below cover the steps that rebin): some particles of some
+  // level take more evaluations than their level's bin gives them. Which level depends on the bin choice's cost
+  // model (Simulation::choose_bins: a finer bin for a few stiff level-2 daughters doubles every particle's
+  // substeps, so the coarse step may shrink instead and put coarser particles one bin finer).
+  EXPECT_GT(sim.work().evaluations[0] + sim.work().evaluations[1] + sim.work().evaluations[2],
+            steps * (n0 + 2 * n1 + 4 * n2))
+      << "some particles step finer than their level: " << sim.work().evaluations[0] << " " << sim.work().evaluations[1]
+      << " " << sim.work().evaluations[2] << " against " << steps * n0 << " " << 2 * steps * n1 << " " << 4 * steps * n2;
   EXPECT_GE(sim.work().substeps, 4 * steps);
   EXPECT_EQ(sim.fine_step_count(), sim.work().substeps);
   sim.remove_ghosts();

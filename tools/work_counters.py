@@ -10,9 +10,13 @@ Each --app is a sphrefine binary (default: build/release/app/sphrefine); with se
 between them (A, B, A, B, ...) so that the machine's drift falls on both alike. One thread per run. Prints one
 markdown row per run and binary: candidates checked per pair evaluated and pairs (run.json's
 neighbour_candidates and pair_interactions, the same at every repetition: the runs are deterministic), and the
-best wall time of the process. Exit status 1 when a run fails.
+best wall time of the process. Also the run's steps, its sweeps (substeps, run.json's sweeps), its force evaluations (run.json's
+force_evaluations_per_level summed) and the level-0 evaluations per level-0 particle-second (the level_0 column
+of series.csv integrated over time by the trapezoid rule over its rows): in a coarse-only run that is its steps
+per second, and issue #16 asks a dynamic run's coarse particles for no more.
 """
 import argparse
+import csv
 import json
 import os
 import subprocess
@@ -34,7 +38,13 @@ def run_once(app, scene, overrides, out):
         sys.exit(f"{' '.join(cmd)} failed: {r.stderr.strip()}")
     with open(os.path.join(out, "run.json")) as f:
         j = json.load(f)
-    return wall, j["neighbour_candidates"], j["pair_interactions"]
+    with open(os.path.join(out, "series.csv")) as f:
+        rows = list(csv.DictReader(f))
+    level0_seconds = sum(0.5 * (float(a["level_0"]) + float(b["level_0"])) * (float(b["time"]) - float(a["time"]))
+                         for a, b in zip(rows, rows[1:]))
+    evals = j["force_evaluations_per_level"]
+    return wall, (j["neighbour_candidates"], j["pair_interactions"], j["steps_this_run"], j["sweeps"], sum(evals),
+                  evals[0] / level0_seconds if level0_seconds > 0 else float("nan"))
 
 
 def main():
@@ -47,8 +57,8 @@ def main():
     for a in apps:
         if not os.access(a, os.X_OK):
             sys.exit(f"--app {a}: not an executable")
-    print("| run | binary | candidates / pair | pairs | best wall s |")
-    print("|---|---|---|---|---|")
+    print("| run | binary | candidates / pair | pairs | steps | sweeps | evaluations | level-0 evaluations / level-0 particle-s | best wall s |")
+    print("|---|---|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
         for spec in args.runs:
             scene, *overrides = spec.split(",")
@@ -57,12 +67,13 @@ def main():
             best = {a: None for a in apps}
             for _ in range(args.reps):
                 for a in apps:
-                    wall, cand, pairs = run_once(a, scene, overrides, os.path.join(tmp, "run"))
+                    wall, counts = run_once(a, scene, overrides, os.path.join(tmp, "run"))
                     b = best[a]
-                    best[a] = (min(wall, b[0]) if b else wall, cand, pairs)
+                    best[a] = (min(wall, b[0]) if b else wall, counts)
             for a in apps:
-                wall, cand, pairs = best[a]
-                print(f"| {spec} | {a} | {cand / pairs:.2f} | {pairs:.4g} | {wall:.2f} |", flush=True)
+                wall, (cand, pairs, steps, sweeps, evals, level0_rate) = best[a]
+                print(f"| {spec} | {a} | {cand / pairs:.2f} | {pairs:.4g} | {steps} | {sweeps} | {evals:.4g} | {level0_rate:.1f} | {wall:.2f} |",
+                      flush=True)
 
 
 if __name__ == "__main__":
