@@ -32,6 +32,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "core/equation_of_state.hpp"
 #include "core/particle_store.hpp"
@@ -46,11 +47,13 @@ class Integrator {
   static constexpr int kMaxBin = kBinCount - 1;
   static_assert(kMaxBin < 31, "1 << bins must fit an int");
 
-  Integrator(TimeStepping mode, TaitEquationOfState eos) : mode_(mode), eos_(eos) {}
+  Integrator(TimeStepping mode, TaitEquationOfState eos, int bin_jump = kDefaultBinJump)
+      : mode_(mode), eos_(eos), bin_jump_(bin_jump) {}
 
   TimeStepping mode() const { return mode_; }
   int bin_cap() const { return mode_ == TimeStepping::global ? 0 : kMaxBin; }
   int bin(std::int32_t b) const { return Activity{0, bin_cap()}.bin(b); }
+  int bin_jump() const { return bin_jump_; }
 
   /// The candidate shares of the target step (below): 2^(-k/8), k = 0..8.
   static constexpr int kShrinks = 9;
@@ -86,6 +89,34 @@ class Integrator {
     // this runs nine times per particle and step in Simulation::choose_bins).
     while (b < bin_cap() && dt0 * kBinWeight[static_cast<std::size_t>(b)] > allowed) ++b;
     return b;
+  }
+
+  /// The bin limiter, one Jacobi pass: each fluid particle's next bin is raised to at least each fluid or halo
+  /// neighbour's (|x_i - x_j| < h_i + h_j, from `grid`, which must be built on the store as it is) minus bin_jump.
+  /// Reads the next bins as they are and writes them once every particle has read (`raised`: workspace), so the
+  /// result does not depend on the order or the threads. Returns whether any changed on this store. Repeated
+  /// (with the halos' and ghosts' copies refreshed between passes) until none changes, every pair of neighbours
+  /// ends at most bin_jump bins apart, at the coarsest such bins above those chosen.
+  template <int D>
+  bool limit_bins(const ParticleView<D>& s, const CellGrid<D>& grid, std::vector<std::int32_t>& raised) const {
+    raised.resize(s.n);
+    const bool changed = par::reduce(
+        s.n, false,
+        [&](std::size_t i) {
+          raised[i] = s.next_bin[i];
+          if (s.kind[i] != Kind::fluid) return false;
+          std::int32_t need = s.next_bin[i];
+          grid.for_each_neighbour(i, s.x, s.h, [&](std::size_t j, double) {
+            if (s.kind[j] == Kind::fluid || s.kind[j] == Kind::halo) need = std::max(need, s.next_bin[j] - bin_jump_);
+          });
+          raised[i] = std::min<std::int32_t>(need, bin_cap());
+          return raised[i] != s.next_bin[i];
+        },
+        [](bool a, bool b) { return a || b; });
+    if (changed) {
+      par::parallel_for(s.n, [&](std::size_t i) { s.next_bin[i] = raised[i]; });
+    }
+    return changed;
   }
 
   /// The pairs the evaluation after substep k (1..2^finest) covers: those of the bins due at t_k.
@@ -134,6 +165,7 @@ class Integrator {
  private:
   TimeStepping mode_;
   TaitEquationOfState eos_;
+  int bin_jump_ = kDefaultBinJump;
 };
 
 }  // namespace sph

@@ -164,6 +164,12 @@ class SimulationT {
   /// Sets every fluid particle's next_bin (Integrator::bin_for) for the coarse step the cheapest of the
   /// candidate shares of the levels' target step gives; true where any differs from its bin (on any rank).
   bool choose_bins();
+  /// The bin limiter (Integrator::limit_bins) on the grid as built, pass after pass with the halos and ghosts
+  /// refreshed between them, until no next bin changes on any rank; skipped when the fluid's next bins span no more
+  /// than bin_jump. True where it raised any.
+  bool limit_bins();
+  /// Whether any fluid particle's next bin differs from its bin (on any rank).
+  bool next_bins_differ();
   /// How many entries particle i has in the expanded set: ghosts 0, walls 1, fluid 1 + its images.
   std::uint32_t output_count(const ParticleView<D>& view, std::size_t i) const;
   /// prepare_neighbours() from its second pass on: expand_offsets_[0..n) holds the output counts and hr the
@@ -184,6 +190,7 @@ class SimulationT {
   // Step workspace of prepare_neighbours (reused, so a step allocates nothing once sizes settle).
   std::vector<std::uint32_t> expand_src_, expand_offsets_;
   std::vector<std::uint32_t> due_prefix_;  // Activity::due_prefix of the current substep
+  std::vector<std::int32_t> bin_raised_;   // Integrator::limit_bins' workspace
   std::vector<std::int8_t> expand_image_;
   std::vector<std::uint8_t> expand_layer_;  // each expanded particle's grid layer (its source's level)
   std::vector<Vec<D>> expand_x_;  // the state before the current step (watchdog rollback)

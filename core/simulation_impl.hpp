@@ -17,7 +17,7 @@ namespace sph {
 
 template <int D>
 SimulationT<D>::SimulationT(Settings settings)
-    : settings_(std::move(settings)), integrator_(settings_.stepping, settings_.eos) {
+    : settings_(std::move(settings)), integrator_(settings_.stepping, settings_.eos, settings_.bin_jump) {
   if (settings_.ghosts) {
     ghosts_.emplace(settings_.geometry.walls(), *settings_.ghosts, settings_.ghost_pressure,
                     settings_.gravity.value_or(Vec<D>::Zero()), settings_.eos);
@@ -182,12 +182,15 @@ void SimulationT<D>::refresh() {
   par::parallel_for(s.n, [&](std::size_t i) {
     if (s.kind[i] == Kind::fluid) s.p[i] = eos.pressure(s.rho[i]);
   });
-  // Levels may have changed (a split or a merge): each particle's bin again, before the rates are evaluated.
+  // Levels may have changed (a split or a merge): each particle's bin again, before the rates are evaluated. The
+  // ghosts and halos carry their sources' next bins, so they take the same bins.
   choose_bins();
-  par::parallel_for(s.n, [&](std::size_t i) {
-    if (s.kind[i] == Kind::fluid) s.bin[i] = s.next_bin[i];
-  });
   prepare_neighbours();
+  limit_bins();
+  const auto t = store_.view();
+  par::parallel_for(t.n, [&](std::size_t i) {
+    if (t.kind[i] != Kind::wall) t.bin[i] = t.next_bin[i];
+  });
   limits_ = global(sweep_->run(store_.view(), grid_, integrator_.activity(1, 0)));
   dt_ = next_dt();
 }
@@ -288,6 +291,44 @@ bool SimulationT<D>::choose_bins() {
 }
 
 template <int D>
+bool SimulationT<D>::next_bins_differ() {
+  const auto s = store_.view();
+  bool differ = par::reduce(
+      s.n, false, [&](std::size_t i) { return s.kind[i] == Kind::fluid && s.next_bin[i] != s.bin[i]; },
+      [](bool a, bool b) { return a || b; });
+  if (domain_) differ = domain_->comm().any(differ);
+  return differ;
+}
+
+template <int D>
+bool SimulationT<D>::limit_bins() {
+  const Integrator& integ = integrator_;
+  if (integ.bin_cap() == 0) return false;
+  // No pair can be more than bin_jump apart unless the fluid's next bins span more (every rank's together).
+  using Span = std::array<std::int32_t, 2>;  // the smallest and the largest next bin
+  const auto s = store_.view();
+  Span span = par::reduce(
+      s.n, Span{kBinCount, -1},
+      [&](std::size_t i) {
+        return s.kind[i] == Kind::fluid ? Span{s.next_bin[i], s.next_bin[i]} : Span{kBinCount, -1};
+      },
+      [](const Span& a, const Span& b) { return Span{std::min(a[0], b[0]), std::max(a[1], b[1])}; });
+  if (domain_) {
+    span[0] = static_cast<std::int32_t>(-domain_->comm().max(-static_cast<double>(span[0])));
+    span[1] = static_cast<std::int32_t>(domain_->comm().max(static_cast<double>(span[1])));
+  }
+  if (span[1] - span[0] <= integ.bin_jump()) return false;
+  bool raised = false;
+  for (;;) {
+    bool changed = integ.limit_bins(store_.view(), grid_, bin_raised_);
+    if (domain_) changed = domain_->comm().any(changed);
+    if (!changed) return raised;
+    raised = true;
+    prepare_neighbours();  // the halos' and ghosts' copies of the raised bins, for the next pass and the sweep
+  }
+}
+
+template <int D>
 void SimulationT<D>::store_restored() {
   const auto s = store_.view();
   int finest = 0;
@@ -365,7 +406,8 @@ StepInfo SimulationT<D>::step(double dt_cap) {
     // Distributed, the ranks agree on whether the substep failed before the next collective call, so that no rank
     // waits for one that has left the step.
     // Before the last evaluation: each particle's bin for the next step (before the ghosts and halos copy it).
-    const bool rebin = k == substeps && integ.bin_cap() > 0 && choose_bins();
+    const bool choose = k == substeps && integ.bin_cap() > 0;
+    bool rebin = choose && choose_bins();
     SweepLimits lim;
     try {
       if (renumbered || domain_) {
@@ -373,6 +415,7 @@ StepInfo SimulationT<D>::step(double dt_cap) {
       } else {
         build_neighbours(hr);
       }
+      if (choose && limit_bins()) rebin = next_bins_differ();
       Activity act = activity(k, finest);
       act.rebin = rebin;
       lim = sweep_->run(store_.view(), grid_, act);

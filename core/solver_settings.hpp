@@ -56,6 +56,7 @@ struct SolverSettingsT {
   double cfl = 0.2;
   double dt_max = 1.0;  // upper bound on the step (s)
   TimeStepping stepping = TimeStepping::global;
+  int bin_jump = kDefaultBinJump;  // per_level: neighbours' bins at most this far apart (Integrator::limit_bins)
   WatchdogSettings watchdog;
 };
 

@@ -42,7 +42,6 @@ struct SweepLimits {
 };
 
 /// 2^-b and 2^b for a bin b (a table: std::ldexp in the pair loop cost 6 % of a step).
-inline constexpr int kBinCount = 16;
 inline constexpr auto kBinWeight = [] {
   std::array<double, kBinCount> w{};
   for (int b = 0; b < kBinCount; ++b) w[static_cast<std::size_t>(b)] = 1.0 / static_cast<double>(1u << b);

@@ -53,6 +53,12 @@ enum class Origin : std::uint8_t { setup = 0, split = 1, fresh_merge = 2, merge 
 
 /// time.stepping (core/integrator.hpp): one global step (the paper's), or power-of-two steps per refinement level.
 enum class TimeStepping { global, per_level };
+/// time.bin_jump's default: the most a particle's time bin may differ from a neighbour's (Integrator::limit_bins).
+/// Two: three levels each in their own bin keep a level-2 particle next to a level-0 one, as the levels ask, and
+/// no neighbour steps more than four times as often as a particle.
+inline constexpr int kDefaultBinJump = 2;
+/// Time bins 0 .. kBinCount - 1 (Integrator::kMaxBin is the last).
+inline constexpr int kBinCount = 16;
 
 using Index = std::uint32_t;
 using ParticleId = std::uint64_t;

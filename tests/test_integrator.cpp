@@ -9,6 +9,7 @@
 #include <random>
 #include <vector>
 
+#include "core/cell_grid.hpp"
 #include "core/integrator.hpp"
 #include "core/refinement/split_pass.hpp"
 #include "core/setup.hpp"
@@ -40,10 +41,11 @@ TEST(Integrator, TheActiveBinFollowsThePowerOfTwoClock) {
 
 /// A rotating, drifting, perturbed circular cloud (as the single-rate conservation test), with a band refined to
 /// level 1 and a smaller patch inside it to level 2, so that pairs of every level combination interact.
-Simulation three_level_cloud(TimeStepping stepping) {
+Simulation three_level_cloud(TimeStepping stepping, int bin_jump = kDefaultBinJump) {
   SolverSettings st = test::isolated_settings(20.0, true);
   st.geometry.container = {Vec<2>(-100, -100), Vec<2>(100, 100)};  // no walls: only the watchdog sees it
   st.stepping = stepping;
+  st.bin_jump = bin_jump;
   Simulation sim(st);
   FluidBlockSpec spec;
   spec.spacing = 0.1;
@@ -167,6 +169,127 @@ TEST(Integrator, PerLevelTakesLongerCoarseStepsThanTheGlobalStep) {
   // The centre of mass moves at the constant total momentum / mass: 0.05 s * |(0.3, -0.2)| ~ 0.018 m; both
   // schemes move it by exactly that, to rounding of the position sums (~1e-16 of ~2 m per particle).
   EXPECT_LE((centre(global.store()) - centre(per_level.store())).norm(), 1e-12);
+}
+
+/// The limiter's fixed point by brute force: Jacobi passes over every pair of fluid particles within h_i + h_j,
+/// each raising a next bin to the neighbours' minus `jump` (capped), until none changes.
+std::vector<std::int32_t> limited_bins_brute_force(const ParticleStore<2>& s, std::vector<std::int32_t> b, int jump) {
+  for (bool changed = true; changed;) {
+    std::vector<std::int32_t> nb = b;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      if (s.kind[i] != Kind::fluid) continue;
+      for (std::size_t j = 0; j < s.size(); ++j) {
+        const double support = s.h[i] + s.h[j];
+        if (j == i || s.kind[j] != Kind::fluid || (s.x[i] - s.x[j]).squaredNorm() >= support * support) continue;
+        nb[i] = std::max(nb[i], b[j] - jump);
+      }
+      nb[i] = std::min<std::int32_t>(nb[i], Integrator::kMaxBin);
+    }
+    changed = nb != b;
+    b = nb;
+  }
+  return b;
+}
+
+// The bin limiter (Integrator::limit_bins) on the solver's grid against its brute-force twin: a few particles put
+// five bins finer than their level, then passes until none changes. The result is the brute force's fixed point,
+// every pair of neighbours ends at most bin_jump apart, and bins are only ever raised.
+TEST(Integrator, BinLimiterEqualsBruteForceAndBoundsNeighbours) {
+  Simulation sim = three_level_cloud(TimeStepping::per_level);
+  sim.remove_ghosts();
+  ParticleStore<2> s = sim.store();
+  std::mt19937_64 rng(11);
+  std::uniform_int_distribution<int> one_in(0, 40);
+  for (std::size_t i = 0; i < s.size(); ++i) s.next_bin[i] = s.level[i] + (one_in(rng) == 0 ? 5 : 0);
+  CellGrid<2> grid;
+  test::build_level_grid_in_order(s, grid);
+  ASSERT_EQ(grid.layer_count(), 3);
+  const std::vector<std::int32_t> chosen(s.next_bin.data(), s.next_bin.data() + s.size());
+  for (const int jump : {1, 2, 3}) {
+    SCOPED_TRACE(testing::Message() << "bin_jump " << jump);
+    std::copy(chosen.begin(), chosen.end(), s.next_bin.data());
+    const Integrator integ(TimeStepping::per_level, TaitEquationOfState{}, jump);
+    std::vector<std::int32_t> raised;
+    int passes = 0;
+    while (integ.limit_bins(s.view(), grid, raised)) {
+      ++passes;
+      ASSERT_LE(passes, Integrator::kMaxBin) << "each pass that changes raises some bin, and bins stop at the cap";
+    }
+    // A bin five above its neighbours' raises ring after ring of neighbours, the k-th pass's ring to 5 - k jump
+    // above theirs while that is positive: at least ceil(5 / jump) - 1 passes that change something.
+    EXPECT_GE(passes, (5 + jump - 1) / jump - 1) << "the raise propagates over several passes";
+    const std::vector<std::int32_t> twin = limited_bins_brute_force(s, chosen, jump);
+    std::size_t raised_count = 0, pairs = 0;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      EXPECT_EQ(s.next_bin[i], twin[i]) << "particle " << i;
+      EXPECT_GE(s.next_bin[i], chosen[i]);
+      raised_count += s.next_bin[i] > chosen[i];
+      for (std::size_t j = 0; j < s.size(); ++j) {
+        const double support = s.h[i] + s.h[j];
+        if (j == i || (s.x[i] - s.x[j]).squaredNorm() >= support * support) continue;
+        ++pairs;
+        EXPECT_LE(std::abs(s.next_bin[i] - s.next_bin[j]), jump);
+      }
+    }
+    EXPECT_GT(raised_count, 20u);
+    EXPECT_GT(pairs, 1000u);
+  }
+}
+
+// With bin_jump = 1, over 200 coarse steps of the three-level cloud: after every step no two neighbours' bins differ
+// by more than one; the limiter acted (the run takes more evaluations than with the default bin_jump = 2, where
+// the daughters at the level jumps that step a bin finer than their level sit two bins from their coarse
+// neighbours); linear and angular momentum stay exact (the bounds of the conservation test above: raised bins
+// change from step to step, so steps rebin); and the run is the same at 1 and 2 threads.
+TEST(Integrator, BinJumpOneKeepsNeighboursWithinOneBinAndMomentumExact) {
+  const int threads = omp_get_max_threads();
+  const std::uint64_t steps = test::short_runs() ? 40 : 200;
+  std::uint64_t default_evaluations = 0;
+  {
+    omp_set_num_threads(1);
+    Simulation sim = three_level_cloud(TimeStepping::per_level);
+    for (std::uint64_t k = 0; k < steps; ++k) sim.step();
+    for (const std::uint64_t e : sim.work().evaluations) default_evaluations += e;
+  }
+  ParticleStore<2> result[2];
+  for (int t = 1; t <= 2; ++t) {
+    omp_set_num_threads(t);
+    Simulation sim = three_level_cloud(TimeStepping::per_level, 1);
+    const Totals m0 = totals(sim.store());
+    const test::MomentumScales sc = test::momentum_scales(sim.store());
+    std::size_t violations = 0;
+    for (std::uint64_t k = 0; k < steps; ++k) {
+      sim.step();
+      const auto& s = sim.store();
+      for (std::size_t i = 0; i < s.size(); ++i) {
+        if (s.kind[i] != Kind::fluid) continue;
+        for (std::size_t j = i + 1; j < s.size(); ++j) {
+          const double support = s.h[i] + s.h[j];
+          if (s.kind[j] != Kind::fluid || (s.x[i] - s.x[j]).squaredNorm() >= support * support) continue;
+          violations += std::abs(s.bin[i] - s.bin[j]) > 1;
+        }
+      }
+    }
+    EXPECT_EQ(violations, 0u);
+    std::uint64_t evaluations = 0;
+    for (const std::uint64_t e : sim.work().evaluations) evaluations += e;
+    EXPECT_GT(evaluations, default_evaluations) << "the limiter raised some bins";
+    sim.remove_ghosts();
+    const Totals m1 = totals(sim.store());
+    EXPECT_LE((m1.P - m0.P).norm(), 1e-12 * sc.linear);
+    EXPECT_LE(std::abs(m1.L - m0.L), 1e-10 * sc.angular);
+    result[t - 1] = sim.store();
+  }
+  omp_set_num_threads(threads);
+  const auto idx0 = fluid_by_id(result[0]), idx1 = fluid_by_id(result[1]);
+  ASSERT_EQ(idx0.size(), idx1.size());
+  std::size_t differing = 0;
+  for (std::size_t k = 0; k < idx0.size(); ++k) {
+    const std::size_t i = idx0[k], j = idx1[k];
+    differing += result[0].x[i] != result[1].x[j] || result[0].v[i] != result[1].v[j] ||
+                 result[0].rho[i] != result[1].rho[j] || result[0].bin[i] != result[1].bin[j];
+  }
+  EXPECT_EQ(differing, 0u);
 }
 
 // The same bits at 1 and 2 threads with per-level steps (the due-particle prefix, the substep kicks and the

@@ -254,6 +254,7 @@ std::vector<Json> scenes_with_every_key() {
   other["material"] = Json{{"rho0", 1000}, {"c0", 30}, {"reference_speed", 3}};
   other["effects"]["lennard_jones_wall"] = Json{{"strength", 100}, {"spacing", 0.05}};
   other["effects"]["refinement"] = Json{{"v_threshold", 5}, {"max_level", 2}, {"coarsening", Json{{"hold_time", 1}}}};
+  other["time"]["bin_jump"] = 1;
   other["effects"]["static_refinement"] = Json{{"rsp_k", 1}};
   Json few = full_scene();
   few["effects"]["refinement"] = Json{{"criterion", "few_neighbours"}, {"min_neighbours", 6}, {"max_level", 2}};

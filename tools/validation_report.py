@@ -573,10 +573,11 @@ def findings_section(f):
                 return part
             out.append(f"- {case}, time steps per level (time.stepping = per_level, the _pl rows; measured): "
                        + "; ".join(pl_part(*p) for p in pl)
-                       + ". A coarse particle now takes one force evaluation per coarse step; the fine particles, "
-                       "most of the moving fluid once the velocity criterion has marked it, take as many as before, "
-                       "so the saving is bounded by the coarse share of the particles (target: 35 % for the dam break, "
-                       "45 % for the drop, at the paper's counts).")
+                       + ". A coarse particle takes one force evaluation per coarse step, or more where its own limit "
+                       "or the bin choice puts it in a finer bin (docs/METHOD.md, \"Time steps per level\"); the fine "
+                       "particles, most of the moving fluid once the velocity criterion has marked it, take as many as "
+                       "with one global step, so the saving is bounded by the coarse share of the particles (target: "
+                       "35 % for the dam break, 45 % for the drop, at the paper's counts).")
     for key, label in (("dam_break_local", "Breaking dam"), ("drop_local", "Drop")):
         if f.get(key):
             out += local_findings(label, f[key])

@@ -115,6 +115,7 @@ struct Time {
   std::optional<double> output_interval;  // default end / 100
   double dt_max = 1.0;
   TimeStepping stepping = TimeStepping::global;  // "global" or "per_level" (core/integrator.hpp)
+  int bin_jump = kDefaultBinJump;                // per_level: the bin limiter (Integrator::limit_bins)
   bool operator==(const Time&) const = default;
 
   double interval() const { return output_interval.value_or(end / 100.0); }

@@ -35,6 +35,7 @@ SolverSettingsT<D> solver_settings(const Scene& scene) {
   s.cfl = scene.time.cfl;
   s.dt_max = scene.time.dt_max;
   s.stepping = scene.time.stepping;
+  s.bin_jump = scene.time.bin_jump;
   return s;
 }
 

@@ -145,6 +145,11 @@ const S<Time>& time_section() {
               .means("upper bound on the step"));
     d.add(value<Time>("stepping", member(&Time::stepping))
               .means("`global`: one step for every particle; `per_level`: level `l` steps `dt0 / 2^l`"));
+    d.add(value<Time>("bin_jump", member(&Time::bin_jump))
+              .range(Range::between(1, kBinCount - 1))
+              .note("`per_level` only")
+              .means("the most a particle's time bin may differ from a neighbour's: a particle steps at least "
+                     "`2^-bin_jump` as often as its most frequent neighbour (a limiter, docs/METHOD.md)"));
     return d;
   }();
   return s;
