@@ -38,6 +38,7 @@
 #include "core/particle_store.hpp"
 #include "core/solver_settings.hpp"
 #include "core/sweep.hpp"
+#include "parallel/range_max.hpp"
 
 namespace sph {
 
@@ -93,18 +94,41 @@ class Integrator {
 
   /// The bin limiter, one Jacobi pass: each fluid particle's next bin is raised to at least each fluid or halo
   /// neighbour's (|x_i - x_j| < h_i + h_j, from `grid`, which must be built on the store as it is) minus bin_jump.
-  /// Reads the next bins as they are and writes them once every particle has read (`raised`: workspace), so the
+  /// The limiter's workspace, reused from pass to pass.
+  struct BinLimiterWork {
+    std::vector<std::int32_t> raised;
+    par::RangeMax<std::int8_t> reach;  // the next bins of the fluid and halos in store order (others -1)
+  };
+
+  /// Reads the next bins as they are and writes them once every particle has read (`work.raised`), so the
   /// result does not depend on the order or the threads. Returns whether any changed on this store. Repeated
-  /// (with the halos' and ghosts' copies refreshed between passes) until none changes, every pair of neighbours
-  /// ends at most bin_jump bins apart, at the coarsest such bins above those chosen.
+  /// (with the halos' copies refreshed between passes) until none changes, every pair of neighbours ends at most
+  /// bin_jump bins apart, at the coarsest such bins above those chosen.
+  /// A particle is first tested against the largest next bin in its candidate runs (the store ranges the grid
+  /// scans for it, a superset of its neighbours), in constant time a run (par::RangeMax), and before that against
+  /// the largest next bin in the store; only where that bin is more than bin_jump above its own are the
+  /// neighbours themselves walked. The result is the same as walking every particle's neighbours; most
+  /// particles, in a region of one bin, skip the walk.
   template <int D>
-  bool limit_bins(const ParticleView<D>& s, const CellGrid<D>& grid, std::vector<std::int32_t>& raised) const {
+  bool limit_bins(const ParticleView<D>& s, const CellGrid<D>& grid, BinLimiterWork& work) const {
+    static_assert(kBinCount <= 127, "next bins are held as int8 in the range table");
+    std::vector<std::int32_t>& raised = work.raised;
     raised.resize(s.n);
+    work.reach.build(s.n, [&](std::size_t j) {
+      return static_cast<std::int8_t>(s.kind[j] == Kind::fluid || s.kind[j] == Kind::halo ? s.next_bin[j] : -1);
+    });
+    // No particle within bin_jump of the largest next bin in the store can be raised.
+    const std::int32_t top = s.n > 0 ? work.reach.max(0, s.n) : -1;
     const bool changed = par::reduce(
         s.n, false,
         [&](std::size_t i) {
           raised[i] = s.next_bin[i];
-          if (s.kind[i] != Kind::fluid) return false;
+          if (s.kind[i] != Kind::fluid || top - bin_jump_ <= s.next_bin[i]) return false;
+          std::int32_t reach = -1;
+          grid.for_each_support_run(s.x[i], s.h[i], [&](std::uint32_t b, std::uint32_t e) {
+            if (e > b) reach = std::max<std::int32_t>(reach, work.reach.max(b, e));
+          });
+          if (reach - bin_jump_ <= s.next_bin[i]) return false;
           std::int32_t need = s.next_bin[i];
           grid.for_each_neighbour(i, s.x, s.h, [&](std::size_t j, double) {
             if (s.kind[j] == Kind::fluid || s.kind[j] == Kind::halo) need = std::max(need, s.next_bin[j] - bin_jump_);

@@ -164,10 +164,14 @@ class SimulationT {
   /// Sets every fluid particle's next_bin (Integrator::bin_for) for the coarse step the cheapest of the
   /// candidate shares of the levels' target step gives; true where any differs from its bin (on any rank).
   bool choose_bins();
-  /// The bin limiter (Integrator::limit_bins) on the grid as built, pass after pass with the halos and ghosts
-  /// refreshed between them, until no next bin changes on any rank; skipped when the fluid's next bins span no more
-  /// than bin_jump. True where it raised any.
+  /// The bin limiter (Integrator::limit_bins) on the grid as built, pass after pass until no next bin changes on
+  /// any rank (across ranks, with the halos and ghosts refreshed between passes; in one process the passes read
+  /// only the fluid's own bins, and the ghosts copy theirs once at the end); skipped when the fluid's next bins
+  /// span no more than bin_jump. True where it raised any.
   bool limit_bins();
+  /// One process: every ghost's next bin from its source, through the last build's maps (expand_src_,
+  /// expand_image_ and the grid's order), instead of a rebuild.
+  void copy_next_bins_to_ghosts();
   /// Whether any fluid particle's next bin differs from its bin (on any rank).
   bool next_bins_differ();
   /// How many entries particle i has in the expanded set: ghosts 0, walls 1, fluid 1 + its images.
@@ -190,7 +194,8 @@ class SimulationT {
   // Step workspace of prepare_neighbours (reused, so a step allocates nothing once sizes settle).
   std::vector<std::uint32_t> expand_src_, expand_offsets_;
   std::vector<std::uint32_t> due_prefix_;  // Activity::due_prefix of the current substep
-  std::vector<std::int32_t> bin_raised_;   // Integrator::limit_bins' workspace
+  Integrator::BinLimiterWork bin_limiter_;  // Integrator::limit_bins' workspace
+  std::vector<std::uint32_t> ghost_source_;  // copy_next_bins_to_ghosts: each source's index after the build
   std::vector<std::int8_t> expand_image_;
   std::vector<std::uint8_t> expand_layer_;  // each expanded particle's grid layer (its source's level)
   std::vector<Vec<D>> expand_x_;  // the state before the current step (watchdog rollback)

@@ -320,12 +320,31 @@ bool SimulationT<D>::limit_bins() {
   if (span[1] - span[0] <= integ.bin_jump()) return false;
   bool raised = false;
   for (;;) {
-    bool changed = integ.limit_bins(store_.view(), grid_, bin_raised_);
+    bool changed = integ.limit_bins(store_.view(), grid_, bin_limiter_);
     if (domain_) changed = domain_->comm().any(changed);
-    if (!changed) return raised;
+    if (!changed) break;
     raised = true;
-    prepare_neighbours();  // the halos' and ghosts' copies of the raised bins, for the next pass and the sweep
+    // Across ranks, the halos' copies of the raised bins for the next pass (and the ghosts' for the sweep).
+    if (domain_) prepare_neighbours();
   }
+  if (raised && !domain_) copy_next_bins_to_ghosts();  // the sweep weighs ghost pairs by their next bins
+  return raised;
+}
+
+template <int D>
+void SimulationT<D>::copy_next_bins_to_ghosts() {
+  if (!ghosts_) return;
+  const auto s = store_.view();
+  const std::uint32_t* order = grid_.order().data();
+  const std::uint32_t* src = expand_src_.data();
+  const std::int8_t* image = expand_image_.data();
+  ghost_source_.resize(expand_offsets_.size() - 1);  // one entry per particle of the store before the build
+  par::parallel_for(s.n, [&](std::size_t k) {
+    if (image[order[k]] < 0) ghost_source_[src[order[k]]] = static_cast<std::uint32_t>(k);
+  });
+  par::parallel_for(s.n, [&](std::size_t k) {
+    if (image[order[k]] >= 0) s.next_bin[k] = s.next_bin[ghost_source_[src[order[k]]]];
+  });
 }
 
 template <int D>

@@ -209,9 +209,9 @@ TEST(Integrator, BinLimiterEqualsBruteForceAndBoundsNeighbours) {
     SCOPED_TRACE(testing::Message() << "bin_jump " << jump);
     std::copy(chosen.begin(), chosen.end(), s.next_bin.data());
     const Integrator integ(TimeStepping::per_level, TaitEquationOfState{}, jump);
-    std::vector<std::int32_t> raised;
+    Integrator::BinLimiterWork work;
     int passes = 0;
-    while (integ.limit_bins(s.view(), grid, raised)) {
+    while (integ.limit_bins(s.view(), grid, work)) {
       ++passes;
       ASSERT_LE(passes, Integrator::kMaxBin) << "each pass that changes raises some bin, and bins stop at the cap";
     }

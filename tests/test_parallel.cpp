@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <numeric>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "parallel/compaction.hpp"
 #include "parallel/counting_sort.hpp"
 #include "parallel/parallel_for.hpp"
+#include "parallel/range_max.hpp"
 #include "parallel/scan.hpp"
 #include "parallel/threads.hpp"
 
@@ -294,6 +296,28 @@ TEST(Parallel, FloatingPointSumDiffersFromNaiveOrderSoTheTestIsMeaningful) {
   for (std::size_t i = n; i-- > 0;) naive += mixed_double(i);
   const double chunked = par::sum(n, 0.0, [](std::size_t i) { return mixed_double(i); });
   EXPECT_NE(bits(naive), bits(chunked));
+}
+
+// par::RangeMax (the bin limiter's pre-test) against its brute-force twin: the maximum over every range [b, e) of
+// arrays whose lengths are and are not powers of two, including negative entries and ranges of one entry, after
+// a rebuild of the same object with other values and another length.
+TEST(Parallel, RangeMaxEqualsTheMaximumOverEveryRange) {
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> value(-1, 15);
+  par::RangeMax<std::int8_t> table;
+  for (const std::size_t n : {std::size_t{1}, std::size_t{2}, std::size_t{7}, std::size_t{64}, std::size_t{333}}) {
+    std::vector<std::int8_t> a(n);
+    for (auto& x : a) x = static_cast<std::int8_t>(value(rng));
+    table.build(n, [&](std::size_t i) { return a[i]; });
+    ASSERT_EQ(table.size(), n);
+    for (std::size_t b = 0; b < n; ++b) {
+      std::int8_t expect = a[b];
+      for (std::size_t e = b + 1; e <= n; ++e) {
+        expect = std::max(expect, a[e - 1]);
+        ASSERT_EQ(table.max(b, e), expect) << "n " << n << " range [" << b << ", " << e << ")";
+      }
+    }
+  }
 }
 
 }  // namespace
