@@ -31,6 +31,7 @@
 #include "core/neighbour_cells.hpp"
 #include "core/particle_store.hpp"
 #include "core/refinement/family.hpp"
+#include "core/refinement/merge_key.hpp"
 #include "parallel/comm.hpp"
 #include "parallel/partition.hpp"
 
@@ -209,76 +210,78 @@ class DomainT {
     return counts;
   }
 
-  /// Coarsening across ranks, before the merge pass (core/refinement/merge_pass.hpp). The 2^D members of a family
-  /// can sit on different ranks. A family whose mergeable members (own fluid with may[i] != 0) are not all on one
-  /// rank, but are all mergeable, is brought together at its leader, the rank holding its lowest sibling: the others
-  /// lend it copies of their members, appended to the leader's store as fluid with may = 1 (the lenders keep the
-  /// originals). Three messages: each rank sends the keys of its incomplete families to a rank fixed by the parent
-  /// id (a hash), which finds the families all of whose members came and tells each lender where to send; then the
-  /// copies go. Returns what settle_families needs. Collective.
+  /// Coarsening across ranks, before the merge pass (core/refinement/merge_pass.hpp). The members of a merge group
+  /// (core/refinement/merge_key.hpp: the 2^D daughters of one parent, or the candidates of one cell) can sit on
+  /// different ranks. Each group that merges (at least 2^D mergeable candidates: own fluid with may[i] != 0) is
+  /// brought together at its leader, the rank holding its first member in key order: the others lend it copies of
+  /// their members, appended to the leader's store as fluid with may = 1 (the lenders keep the originals). Three
+  /// messages: each rank sends the keys of its candidates to a rank fixed by the group (a hash): with families only
+  /// those of families not whole here, with cells all (a cell's other candidates may be anywhere). That rank finds the
+  /// groups that merge and tells each lender where to send; with cells it also tells every other rank holding a
+  /// candidate of a group led elsewhere, which then sets may = 0 for it (that rank may hold 2^D of the cell, but not
+  /// its first). Then the copies go. Returns what settle_families needs. Collective.
   struct Lent {
     std::size_t first = 0;                // store index of the first copy (the store's size when none came)
     std::vector<std::pair<ParticleId, int>> lenders;  // each copy's id and the rank that lent it, sorted by id
   };
-  Lent lend_families(ParticleStore<D>& store, std::vector<std::uint8_t>& may) const {
+  Lent lend_families(ParticleStore<D>& store, std::vector<std::uint8_t>& may, refine::MergeGroups groups,
+                     const Vec<D>& anchor) const {
     constexpr unsigned children = refine::kChildren<D>;
+    const bool cells = groups == refine::MergeGroups::cell;
     const auto ranks = static_cast<std::size_t>(comm_.size());
     struct Key {
-      ParticleId parent;
-      std::uint32_t sibling;
-      std::int32_t rank;
+      refine::MergeKey key;
+      std::int32_t rank;      // the sender; in the answer, the group's leader
+      std::int32_t selected;  // in the answer: 1 when this member goes to the leader
     };
     std::vector<Key> mine;
     std::vector<std::uint32_t> index;  // store index of mine[k]
     for (std::size_t i = 0; i < store.size(); ++i) {
-      if (!may[i] || store.kind[i] != Kind::fluid || !refine::has_parent(store.id[i])) continue;
-      mine.push_back({refine::parent_id<D>(store.id[i]), refine::sibling_index<D>(store.id[i]), comm_.rank()});
+      refine::MergeKey key;
+      if (!may[i] || store.kind[i] != Kind::fluid || !refine::merge_key<D>(store, i, groups, anchor, key)) continue;
+      mine.push_back({key, comm_.rank(), 0});
       index.push_back(static_cast<std::uint32_t>(i));
     }
     std::vector<std::uint32_t> order(mine.size());
     for (std::uint32_t k = 0; k < order.size(); ++k) order[k] = k;
-    const auto by_member = [&](std::uint32_t a, std::uint32_t b) {
-      return mine[a].parent != mine[b].parent ? mine[a].parent < mine[b].parent : mine[a].sibling < mine[b].sibling;
-    };
-    std::sort(order.begin(), order.end(), by_member);
-    // 1. The keys of the families not whole here, to each family's home rank.
+    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return mine[a].key < mine[b].key; });
+    // 1. The keys, to each group's home rank.
     std::vector<std::vector<std::byte>> out(ranks);
     for (std::size_t k = 0; k < order.size();) {
       std::size_t e = k;
-      while (e < order.size() && mine[order[e]].parent == mine[order[k]].parent) ++e;
-      if (e - k < children) {
-        for (std::size_t j = k; j < e; ++j) par::put(out[home_of(mine[order[j]].parent)], mine[order[j]]);
+      while (e < order.size() && mine[order[e]].key.same_group(mine[order[k]].key)) ++e;
+      if (cells || e - k < children) {
+        for (std::size_t j = k; j < e; ++j) par::put(out[home_of(mine[order[j]].key)], mine[order[j]]);
       }
       k = e;
     }
     std::vector<std::byte> in = comm_.exchange(out);
-    // 2. At home: the families whose 2^D members all came; each lender is told where its member goes.
+    // 2. At home: the groups with at least 2^D candidates; their first 2^D go to the leader, the rank of the first.
     std::vector<Key> keys(in.size() / sizeof(Key));
     if (!keys.empty()) std::memcpy(static_cast<void*>(keys.data()), in.data(), in.size());
-    std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
-      return a.parent != b.parent ? a.parent < b.parent : a.sibling < b.sibling;
-    });
+    std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) { return a.key < b.key; });
     for (auto& b : out) b.clear();
     for (std::size_t k = 0; k < keys.size();) {
       std::size_t e = k;
-      while (e < keys.size() && keys[e].parent == keys[k].parent) ++e;
-      if (e - k == children) {
-        const std::int32_t leader = keys[k].rank;  // the lowest sibling's
+      while (e < keys.size() && keys[e].key.same_group(keys[k].key)) ++e;
+      if (e - k >= children) {
+        const std::int32_t leader = keys[k].rank;
         for (std::size_t j = k; j < e; ++j) {
-          if (keys[j].rank != leader) par::put(out[static_cast<std::size_t>(keys[j].rank)], Key{keys[j].parent, keys[j].sibling, leader});
+          if (keys[j].rank == leader) continue;
+          par::put(out[static_cast<std::size_t>(keys[j].rank)], Key{keys[j].key, leader, j < k + children ? 1 : 0});
         }
       }
       k = e;
     }
     in = comm_.exchange(out);
-    // 3. The copies, to the leaders.
+    // 3. The copies, to the leaders; a candidate of a group led elsewhere does not merge here.
     for (auto& b : out) b.clear();
     for (std::size_t at = 0; at < in.size();) {
       const Key want = par::take<Key>(in, at);
-      const auto it = std::lower_bound(order.begin(), order.end(), want, [&](std::uint32_t k, const Key& w) {
-        return mine[k].parent != w.parent ? mine[k].parent < w.parent : mine[k].sibling < w.sibling;
-      });
-      pack_particle(store, index[*it], out[static_cast<std::size_t>(want.rank)]);
+      const auto it = std::lower_bound(order.begin(), order.end(), want.key,
+                                       [&](std::uint32_t k, const refine::MergeKey& w) { return mine[k].key < w; });
+      if (want.selected) pack_particle(store, index[*it], out[static_cast<std::size_t>(want.rank)]);
+      if (cells) may[index[*it]] = 0;
     }
     std::vector<std::size_t> from;
     Lent lent;
@@ -292,18 +295,14 @@ class DomainT {
     return lent;
   }
 
-  /// After the merge pass: `merged` holds the ids of the lent copies whose family merged here. Each goes back to
-  /// its lender, which removes its original (and its ghosts: the solver rebuilds them). Returns the families merged
-  /// here with lent members. Collective.
-  std::size_t settle_families(ParticleStore<D>& store, const Lent& lent, const std::vector<ParticleId>& merged) const {
+  /// After the merge pass: `merged` holds the ids of the lent copies whose group merged here. Each goes back to
+  /// its lender, which removes its original (and its ghosts: the solver rebuilds them). Collective.
+  void settle_families(ParticleStore<D>& store, const std::vector<ParticleId>& merged, const Lent& lent) const {
     std::vector<std::vector<std::byte>> out(static_cast<std::size_t>(comm_.size()));
-    std::vector<ParticleId> parents;
     for (const ParticleId id : merged) {
       const auto it = std::lower_bound(lent.lenders.begin(), lent.lenders.end(), std::pair<ParticleId, int>{id, -1});
       par::put(out[static_cast<std::size_t>(it->second)], id);
-      parents.push_back(refine::parent_id<D>(id));
     }
-    std::sort(parents.begin(), parents.end());
     const std::vector<ParticleId> gone = sorted_ids(comm_.exchange(out));
     if (!gone.empty()) {
       store.compact([&](std::size_t i) {
@@ -311,7 +310,6 @@ class DomainT {
                !(store.kind[i] == Kind::fluid && std::binary_search(gone.begin(), gone.end(), store.id[i]));
       });
     }
-    return static_cast<std::size_t>(std::unique(parents.begin(), parents.end()) - parents.begin());
   }
 
   /// The loads as the cut assigns the own fluid (each rank's weight by the owner of each particle's cell): max over
@@ -341,13 +339,17 @@ class DomainT {
   static constexpr int kBits = D == 2 ? 31 : 21;  // cell coordinate bits per axis
   static constexpr std::int64_t kMax = (std::int64_t{1} << kBits) - 1;
 
-  /// The rank that matches a family's members across ranks (lend_families): a hash of its parent id, so the families
+  /// The rank that matches a merge group's members across ranks (lend_families): a hash of the group, so the groups
   /// spread evenly over the ranks.
-  std::size_t home_of(ParticleId parent) const {
-    std::uint64_t z = parent + 0x9e3779b97f4a7c15ull;  // splitmix64's finaliser
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return static_cast<std::size_t>((z ^ (z >> 31)) % static_cast<std::uint64_t>(comm_.size()));
+  std::size_t home_of(const refine::MergeKey& key) const {
+    std::uint64_t h = 0;
+    for (const std::uint64_t g : key.group) {
+      std::uint64_t z = h + g + 0x9e3779b97f4a7c15ull;  // splitmix64's finaliser, chained over the words
+      z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+      z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+      h = z ^ (z >> 31);
+    }
+    return static_cast<std::size_t>(h % static_cast<std::uint64_t>(comm_.size()));
   }
   static std::vector<ParticleId> sorted_ids(const std::vector<std::byte>& in) {
     std::vector<ParticleId> ids(in.size() / sizeof(ParticleId));

@@ -41,6 +41,15 @@ ParticleStore<2> lattice_store(const Vec<2>& lo, const Vec<2>& hi, double d) {
 
 std::vector<std::uint8_t> all_of(const ParticleStore<2>& s) { return std::vector<std::uint8_t>(s.size(), 1); }
 
+using refine::MergeGroups;
+constexpr MergeGroups kBothGroupings[] = {MergeGroups::family, MergeGroups::cell};
+const char* name(MergeGroups g) { return g == MergeGroups::family ? "groups: family" : "groups: cell"; }
+
+refine::MergeResult merge(ParticleStore<2>& s, const std::vector<std::uint8_t>& may, const Geometry2& g, double t,
+                          MergeGroups groups) {
+  return refine::merge_families(s, may, g, t, {}, static_cast<std::size_t>(-1), groups);
+}
+
 // Brute-force twin of the merge's bookkeeping: totals over the fluid.
 struct Totals {
   double mass = 0, ke = 0, lz = 0;
@@ -77,8 +86,12 @@ TEST(Family, DaughterIdsNameTheirParentAndSiblingAndStayUnique) {
   EXPECT_FALSE(refine::has_parent(12345));
 }
 
+// With either grouping: on the lattice the set-up makes from the container's corner, each parent's daughters fill
+// one cell of the merged spacing, so the cells are the families.
 TEST(Coarsening, SplitThenMergeOfAnUndisturbedLatticeGivesTheLatticeBack) {
+  for (const MergeGroups groups : kBothGroupings)
   for (Pattern p : {Pattern::aap, Pattern::rsp}) {
+    SCOPED_TRACE(name(groups));
     // Against walls on three sides: AAP daughters of the wall rows sit d/4 from the wall, and merge back.
     const double d = 0.5;
     const Geometry2 g = open_box(6.0, 10.0);
@@ -86,7 +99,7 @@ TEST(Coarsening, SplitThenMergeOfAnUndisturbedLatticeGivesTheLatticeBack) {
     const ParticleStore<2> original = s;
     refine::split_marked(s, all_of(s), p, 1.0, 5, g.walls(), 1.0);
     ASSERT_EQ(s.size(), 4 * original.size());
-    const refine::MergeResult r = refine::merge_families(s, all_of(s), g, 2.0);
+    const refine::MergeResult r = merge(s, all_of(s), g, 2.0, groups);
     EXPECT_EQ(r.merged, original.size());
     EXPECT_EQ(r.kept_off_walls, 0u);
     ASSERT_EQ(s.size(), original.size());
@@ -123,6 +136,8 @@ ParticleStore<2> disturbed_families(std::size_t parents, unsigned seed, int leve
 }
 
 TEST(Coarsening, EveryMergeKeepsMassAndMomentumAndReportsWhatItRemoves) {
+  for (const MergeGroups groups : kBothGroupings) {
+  SCOPED_TRACE(name(groups));
   ParticleStore<2> s = disturbed_families(64, 3, 2);
   const Geometry2 g = open_box(20, 20);
   for (int pass = 0; pass < 2; ++pass) {  // level 2 -> 1, then 1 -> 0
@@ -133,7 +148,7 @@ TEST(Coarsening, EveryMergeKeepsMassAndMomentumAndReportsWhatItRemoves) {
       sL += s.m[i] * s.x[i].norm() * s.v[i].norm();
     }
     const std::size_t n = s.size();
-    const refine::MergeResult r = refine::merge_families(s, all_of(s), g, 1.0);
+    const refine::MergeResult r = merge(s, all_of(s), g, 1.0, groups);
     EXPECT_EQ(r.merged, n / 4);
     const Totals after = totals(s);
     EXPECT_NEAR(after.mass, before.mass, 1e-12 * before.mass);  // sums in a different order: rounding only
@@ -142,6 +157,7 @@ TEST(Coarsening, EveryMergeKeepsMassAndMomentumAndReportsWhatItRemoves) {
     EXPECT_NEAR(r.d_kinetic, after.ke - before.ke, 1e-12 * before.ke);
     EXPECT_NEAR(r.d_angular, after.lz - before.lz, 1e-12 * sL);
     EXPECT_LT(r.d_kinetic, 0.0) << "the motion about the centre of mass is lost, never gained";
+  }
   }
 }
 
@@ -255,15 +271,17 @@ bool same_state(const ParticleStore<2>& a, const ParticleStore<2>& b) {
 }
 
 TEST(Coarsening, MergeIsBitwiseIndependentOfTheThreadCount) {
+  for (const MergeGroups groups : kBothGroupings) {
+  SCOPED_TRACE(name(groups));
   const int threads = omp_get_max_threads();
   const ParticleStore<2> base = disturbed_families(4096, 13, 1);
   std::vector<std::uint8_t> may(base.size(), 0);
   for (std::size_t i = 0; i < base.size(); ++i) may[i] = base.v[i][0] > 0.0;  // some families complete, some not
   ParticleStore<2> one = base, two = base;
   omp_set_num_threads(1);
-  const auto r1 = refine::merge_families(one, may, open_box(200, 20), 1.0);
+  const auto r1 = merge(one, may, open_box(200, 20), 1.0, groups);
   omp_set_num_threads(2);
-  const auto r2 = refine::merge_families(two, may, open_box(200, 20), 1.0);
+  const auto r2 = merge(two, may, open_box(200, 20), 1.0, groups);
   omp_set_num_threads(threads);
   EXPECT_GT(r1.merged, 0u);
   EXPECT_LT(r1.merged, base.size() / 4);
@@ -271,6 +289,7 @@ TEST(Coarsening, MergeIsBitwiseIndependentOfTheThreadCount) {
   EXPECT_EQ(r1.d_kinetic, r2.d_kinetic);
   EXPECT_EQ(r1.d_angular, r2.d_angular);
   EXPECT_TRUE(same_state(one, two));
+  }
 }
 
 // The refinement stage on a still tank: a velocity field set by hand marks a block, the block is split, the
@@ -375,3 +394,115 @@ TEST(Coarsening, NoFamilyFlipsBetweenSplitAndMergeFromOneCheckToTheNext) {
 }
 
 }  // namespace
+
+namespace {
+
+// Level-1 daughters of a lattice of parents (spacing 2 d1), all moved by `shift`: each cell of the merged spacing
+// then holds daughters of up to four parents.
+ParticleStore<2> shifted_daughters(const Vec<2>& shift, const Geometry2& g) {
+  ParticleStore<2> s = lattice_store(Vec<2>(2, 2), Vec<2>(6, 5), 0.5);
+  refine::split_marked(s, all_of(s), Pattern::aap, 1.0, 8, g.walls(), 0.0);
+  for (std::size_t i = 0; i < s.size(); ++i) s.x[i] += shift;
+  return s;
+}
+
+std::vector<ParticleId> sorted_fluid_ids(const ParticleStore<2>& s) {
+  std::vector<ParticleId> ids;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.kind[i] == Kind::fluid) ids.push_back(s.id[i]);
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+
+}  // namespace
+
+// Cell groups merge daughters of different parents that share a cell of the merged spacing: the daughters moved by
+// half a daughter spacing along x and y, so every interior cell holds one daughter of each of four parents (the
+// lattice's edge cells fewer). Each merged particle takes one of the members' ids (the lowest generation, then the
+// lowest id), at level 0 with the parents' spacing, at the cell's centre; mass and momentum are kept; no id is held
+// twice.
+TEST(Coarsening, CellGroupsMergeDaughtersOfDifferentParents) {
+  const Geometry2 g = open_box(20, 20);
+  const double d1 = 0.25;  // the daughters' spacing
+  ParticleStore<2> s = shifted_daughters(Vec<2>(d1, d1), g);
+  const std::size_t n = s.size();
+  ASSERT_EQ(n, 192u);  // 8 x 6 parents
+  double sP = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    s.v[i] = Vec<2>(0.1 * static_cast<double>(i % 7), -0.05 * static_cast<double>(i % 5));
+    sP += s.m[i] * s.v[i].norm();
+  }
+  const Totals before = totals(s);
+  const std::vector<ParticleId> ids_before = sorted_fluid_ids(s);
+  const refine::MergeResult r = merge(s, all_of(s), g, 1.0, MergeGroups::cell);
+  // The daughters' x after the shift: 2.375 .. 6.125 by 0.25, so the cells [2.5, 3) .. [5.5, 6) hold two each (7)
+  // and the two edge cells one; y: 2.375 .. 5.125, five cells of two. 7 x 5 cells of four.
+  EXPECT_EQ(r.merged, 35u);
+  EXPECT_EQ(s.size(), n - 3 * 35);
+  const Totals after = totals(s);
+  EXPECT_NEAR(after.mass, before.mass, 1e-12 * before.mass);
+  EXPECT_LE((after.P - before.P).norm(), 1e-12 * sP);
+  const std::vector<ParticleId> ids = sorted_fluid_ids(s);
+  EXPECT_EQ(std::adjacent_find(ids.begin(), ids.end()), ids.end()) << "an id is held twice";
+  std::size_t merged = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.level[i] != 0) continue;
+    ++merged;
+    EXPECT_TRUE(std::binary_search(ids_before.begin(), ids_before.end(), s.id[i])) << "a merged particle takes a member's id";
+    EXPECT_EQ(refine::generation(s.id[i]), 1);
+    EXPECT_EQ(s.d[i], 2 * d1);
+    EXPECT_EQ(s.m[i], 1000.0 * (2 * d1) * (2 * d1));  // four daughters of a parent's mass rho0 (2 d1)^2
+    const Vec<2> c = s.x[i] / (2 * d1);  // in cells: the members sit a quarter cell from the centre
+    EXPECT_NEAR(c[0] - std::floor(c[0]), 0.5, 1e-12);
+    EXPECT_NEAR(c[1] - std::floor(c[1]), 0.5, 1e-12);
+  }
+  EXPECT_EQ(merged, 35u);
+}
+
+// A cell with more than four candidates merges its four lowest ids; with three, none. And ids stay unique over
+// cycles of split, stir and merge, whatever ids the merged particles took.
+TEST(Coarsening, CellGroupsTakeTheFourLowestIdsAndKeepIdsUniqueOverCycles) {
+  const Geometry2 g = open_box(20, 20);
+  {
+    ParticleStore<2> s = shifted_daughters(Vec<2>(0, 0), g);  // each cell holds one family
+    // One daughter of the corner family (parent at (2.25, 2.25)) moves to the next cell along x, (2.5, 3) x (2, 2.5):
+    // that cell holds five candidates, the corner cell three.
+    const double d1 = 0.25;
+    std::size_t moved = s.size();
+    for (std::size_t i = 0; i < s.size() && moved == s.size(); ++i)
+      if (s.x[i][0] < 2.5 && s.x[i][1] < 2.5) moved = i;
+    ASSERT_LT(moved, s.size());
+    s.x[moved][0] += 2 * d1;
+    const ParticleId moved_id = s.id[moved];
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      if (i != moved && s.x[i][0] > 2.5 && s.x[i][0] < 3.0 && s.x[i][1] < 2.5) ASSERT_LT(moved_id, s.id[i]) << "the premise: the corner family's ids come first";
+    }
+    const std::size_t n = s.size();
+    const refine::MergeResult r = merge(s, all_of(s), g, 1.0, MergeGroups::cell);
+    EXPECT_EQ(r.merged, n / 4 - 1) << "the cell of three stays split; the cell of five merges four";
+    std::size_t level1 = 0;
+    bool moved_left = false;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      level1 += s.level[i] == 1;
+      moved_left = moved_left || s.id[i] == moved_id;
+    }
+    EXPECT_EQ(level1, 4u) << "the three of the corner cell and the highest id of the cell of five";
+    EXPECT_TRUE(moved_left) << "the moved daughter has the lowest id of its new cell: the merged particle takes it";
+  }
+  {
+    std::mt19937_64 rng(17);
+    std::uniform_real_distribution<double> U(-1.0, 1.0);
+    ParticleStore<2> s = lattice_store(Vec<2>(2, 2), Vec<2>(8, 6), 0.5);
+    for (int cycle = 0; cycle < 6; ++cycle) {
+      SCOPED_TRACE("cycle " + std::to_string(cycle));
+      refine::split_marked(s, all_of(s), Pattern::aap, 1.0, 8, g.walls(), 0.0);
+      for (std::size_t i = 0; i < s.size(); ++i) s.x[i] += 0.6 * s.d[i] * Vec<2>(U(rng), U(rng));  // stirred
+      const double mass = totals(s).mass;
+      const refine::MergeResult r = merge(s, all_of(s), g, 1.0, MergeGroups::cell);
+      EXPECT_GT(r.merged, 0u);
+      EXPECT_NEAR(totals(s).mass, mass, 1e-12 * mass);
+      const std::vector<ParticleId> ids = sorted_fluid_ids(s);
+      ASSERT_EQ(std::adjacent_find(ids.begin(), ids.end()), ids.end()) << "an id is held twice";
+    }
+  }
+}

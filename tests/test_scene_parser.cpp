@@ -311,7 +311,7 @@ TEST(SceneParser, MisplacedKeysNameWhatTheyAreAllowedFor) {
   doc = full_scene();
   doc["effects"]["refinement"]["coarsening"] = Json{{"min_neighbours", 20}};
   EXPECT_EQ(error_of(doc), "scene error: effects.refinement.coarsening.min_neighbours: unknown key; allowed for criterion "
-                           "zone: hold_time");
+                           "zone: hold_time, groups");
   doc = full_scene();
   doc["effects"]["refinement"]["v_threshold"] = 3;
   EXPECT_EQ(error_of(doc).rfind("scene error: effects.refinement.v_threshold: unknown key; allowed for criterion zone: ", 0),
@@ -332,7 +332,14 @@ TEST(SceneParser, CoarseningDefaultsFollowTheSplitTest) {
   ASSERT_TRUE(s.effects.refinement->coarsening);
   EXPECT_EQ(s.effects.refinement->coarsening->v_threshold, 4.0);
   EXPECT_EQ(s.effects.refinement->coarsening->hold_time, sph::refine::CoarseningSettings{}.hold_time);
+  EXPECT_EQ(s.effects.refinement->coarsening->groups, sph::refine::MergeGroups::family) << "the daughters of one parent";
   EXPECT_EQ(scene_from_json(scene_to_json(s)), s);
+  doc["effects"]["refinement"]["coarsening"] = Json{{"groups", "cell"}};
+  s = scene_from_json(doc);
+  EXPECT_EQ(s.effects.refinement->coarsening->groups, sph::refine::MergeGroups::cell);
+  EXPECT_EQ(scene_from_json(scene_to_json(s)), s);
+  doc["effects"]["refinement"]["coarsening"] = Json{{"groups", "neighbours"}};
+  EXPECT_EQ(error_of(doc), "scene error: effects.refinement.coarsening.groups: must be one of: family, cell (got 'neighbours')");
   doc["effects"]["refinement"] = Json{{"criterion", "few_neighbours"}, {"min_neighbours", 6}, {"coarsening", Json::object()},
                                       {"max_level", 2}};
   s = scene_from_json(doc);

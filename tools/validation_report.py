@@ -61,7 +61,9 @@ def refinement(pattern="aap", v=10.0, k=1.0, max_level=1, coarsening=False):
     r = {"criterion": "velocity", "v_threshold": v, "pattern": pattern, "rsp_k": k, "check_interval": 100,
          "max_level": max_level}
     if coarsening:
-        r["coarsening"] = {}  # the defaults: merge below v / 2, after 0.5 s at the level (docs/SCENES.md)
+        # The defaults (merge below v / 2, after 0.5 s at the level), in cell groups: in the dam break the daughters of
+        # one parent are stirred apart before they slow, and no family merges (docs/METHOD.md).
+        r["coarsening"] = {"groups": "cell"}
     return json.dumps(r)
 
 

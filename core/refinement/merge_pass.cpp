@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 #include "core/refinement/family.hpp"
+#include "core/refinement/merge_key.hpp"
 #include "parallel/parallel_for.hpp"
 
 namespace sph::refine {
@@ -20,12 +22,6 @@ bool clear_of_walls(const Vec<D>& x, const Geometry<D>& geometry, const std::vec
   }
   return true;
 }
-
-struct Candidate {
-  ParticleId parent;
-  unsigned sibling;
-  std::uint32_t index;
-};
 
 template <int D>
 struct FamilyOutcome {
@@ -45,7 +41,7 @@ template <int D>
 MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::uint8_t>& may_merge,
                                 const Geometry<D>& geometry, double time,
                                 const std::function<bool(const Vec<D>&, const Vec<D>&)>& would_split,
-                                std::size_t copies_from) {
+                                std::size_t copies_from, MergeGroups groups) {
   constexpr unsigned children = kChildren<D>;
   MergeResultIn<D> result;
   const std::size_t n = store.size();
@@ -54,26 +50,27 @@ MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::
   const auto drop_copies = [&] {
     if (copies_from < n) store.resize(copies_from);
   };
-  std::vector<Candidate> cand;
+  // Candidates sorted by their merge key (core/refinement/merge_key.hpp): a group's candidates in a row, in key
+  // order. Keys are unique among live particles, so the order is fixed by the data.
+  const Vec<D> anchor = geometry.container.lo;
+  std::vector<std::pair<MergeKey, std::uint32_t>> cand;
   for (std::size_t i = 0; i < n; ++i) {
-    if (!may_merge[i] || store.kind[i] != Kind::fluid || !has_parent(store.id[i])) continue;
-    cand.push_back({parent_id<D>(store.id[i]), sibling_index<D>(store.id[i]), static_cast<std::uint32_t>(i)});
+    MergeKey key;
+    if (!may_merge[i] || store.kind[i] != Kind::fluid || !merge_key<D>(store, i, groups, anchor, key)) continue;
+    cand.emplace_back(key, static_cast<std::uint32_t>(i));
   }
-  // (parent, sibling) is unique among live particles, so the sorted order is fixed by the data.
-  std::sort(cand.begin(), cand.end(), [](const Candidate& a, const Candidate& b) {
-    return a.parent != b.parent ? a.parent < b.parent : a.sibling < b.sibling;
-  });
+  std::sort(cand.begin(), cand.end());
   std::vector<FamilyOutcome<D>> fam;
-  for (std::size_t k = 0; k + (children - 1) < cand.size();) {
-    if (cand[k + (children - 1)].parent != cand[k].parent) {
-      ++k;
-      continue;
+  for (std::size_t k = 0; k < cand.size();) {
+    std::size_t e = k + 1;
+    while (e < cand.size() && cand[e].first.same_group(cand[k].first)) ++e;
+    if (e - k >= children) {  // the group's first 2^D (a family has no more)
+      FamilyOutcome<D> f;
+      for (unsigned a = 0; a < children; ++a) f.members[a] = cand[k + a].second;
+      f.keeper = *std::min_element(f.members.begin(), f.members.end());
+      fam.push_back(f);
     }
-    FamilyOutcome<D> f;
-    for (unsigned a = 0; a < children; ++a) f.members[a] = cand[k + a].index;
-    f.keeper = *std::min_element(f.members.begin(), f.members.end());
-    fam.push_back(f);
-    k += children;
+    k = e;
   }
   if (fam.empty()) {
     drop_copies();
@@ -139,10 +136,15 @@ MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::
     ++result.merged;
     result.d_kinetic += f.d_kinetic;
     result.d_angular += f.d_angular;
+    bool lent = false;
     for (const std::uint32_t i : f.members) {
       drop[i] = i != f.keeper;
-      if (i >= copies_from) result.merged_copies.push_back(store.id[i]);
+      if (i >= copies_from) {
+        result.merged_copies.push_back(store.id[i]);
+        lent = true;
+      }
     }
+    result.merged_with_copies += lent;
   }
   if (result.merged == 0) {
     drop_copies();
@@ -155,7 +157,19 @@ MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::
     const FamilyOutcome<D>& f = fam[r];
     if (f.verdict != 0) return;
     const std::size_t k = f.keeper;
-    const ParticleId child = s.id[f.members[0]];
+    // The four daughters of one parent give it its id back (sibling order: members[0] is daughter 0). Any other
+    // group takes the id of the member of the lowest generation (then the lowest id): ids stay unique, since that
+    // member leaves, and a particle and its descendants are never alive together.
+    ParticleId merged_id = parent_id<D>(s.id[f.members[0]]);
+    bool siblings = has_parent(s.id[f.members[0]]);
+    for (const std::uint32_t i : f.members) siblings = siblings && has_parent(s.id[i]) && parent_id<D>(s.id[i]) == merged_id;
+    if (!siblings) {
+      merged_id = s.id[f.members[0]];
+      for (const std::uint32_t i : f.members) {
+        const ParticleId id = s.id[i];
+        if (generation(id) < generation(merged_id) || (generation(id) == generation(merged_id) && id < merged_id)) merged_id = id;
+      }
+    }
     s.x[k] = f.x;
     s.v[k] = f.v;
     s.vh[k] = f.vh;
@@ -165,7 +179,7 @@ MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::
     s.h[k] = 2.0 * s.h[f.members[0]];  // powers of two: the parent's h and d exactly
     s.d[k] = 2.0 * s.d[f.members[0]];
     s.level[k] = s.level[f.members[0]] - 1;
-    s.id[k] = parent_id<D>(child);
+    s.id[k] = merged_id;
     s.level_time[k] = time;
     s.origin[k] = Origin::fresh_merge;
     s.a[k].setZero();  // the rates are re-evaluated after the pass
@@ -183,9 +197,9 @@ MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::
 
 template MergeResultIn<2> merge_families<2>(ParticleStore<2>&, const std::vector<std::uint8_t>&, const Geometry<2>&,
                                             double, const std::function<bool(const Vec<2>&, const Vec<2>&)>&,
-                                            std::size_t);
+                                            std::size_t, MergeGroups);
 template MergeResultIn<3> merge_families<3>(ParticleStore<3>&, const std::vector<std::uint8_t>&, const Geometry<3>&,
                                             double, const std::function<bool(const Vec<3>&, const Vec<3>&)>&,
-                                            std::size_t);
+                                            std::size_t, MergeGroups);
 
 }  // namespace sph::refine

@@ -18,6 +18,7 @@
 #include "core/boundary/wall.hpp"
 #include "core/diagnostics.hpp"
 #include "core/particle_store.hpp"
+#include "core/refinement/refinement_settings.hpp"
 
 namespace sph::refine {
 
@@ -30,6 +31,7 @@ struct MergeResultIn {
   double d_kinetic = 0.0;            // kinetic energy after - before (J/m in 2D, J in 3D), <= 0
   Angular<D> d_angular = zero_angular<D>();  // angular momentum after - before (2D: L_z)
   std::vector<ParticleId> merged_copies;     // the ids of lent copies (see below) whose family merged
+  std::size_t merged_with_copies = 0;        // families merged with a lent copy among their members
 };
 using MergeResult = MergeResultIn<2>;
 
@@ -49,6 +51,7 @@ template <int D>
 MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::uint8_t>& may_merge,
                                 const Geometry<D>& geometry, double time,
                                 const std::function<bool(const Vec<D>&, const Vec<D>&)>& would_split = {},
-                                std::size_t copies_from = static_cast<std::size_t>(-1));
+                                std::size_t copies_from = static_cast<std::size_t>(-1),
+                                MergeGroups groups = MergeGroups::family);
 
 }  // namespace sph::refine

@@ -21,10 +21,15 @@ enum class CriterionKind {
 /// hold_time and all four pass the merge test of the criterion, which is stricter than the split test
 /// (hysteresis): velocity |v| < v_threshold (below the split threshold); zone: outside the zone;
 /// few_neighbours: at least min_neighbours fluid neighbours (above the split count).
+/// Which particles merge into one (core/refinement/merge_pass.hpp): the 2^D daughters of one parent, or any 2^D
+/// particles of one level (and spacing) that lie in one cell of a lattice of the merged spacing.
+enum class MergeGroups { family, cell };
+
 struct CoarseningSettings {
   double v_threshold = 5.0;  // m/s
   int min_neighbours = 16;
   double hold_time = 0.5;    // s
+  MergeGroups groups = MergeGroups::family;
   bool operator==(const CoarseningSettings&) const = default;
 };
 

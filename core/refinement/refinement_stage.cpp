@@ -31,17 +31,19 @@ std::size_t split_with(SimulationT<D>& sim, std::vector<std::uint8_t>& marks, Pa
 
 template <int D>
 MergeResultIn<D> merge_pass(SimulationT<D>& sim, std::vector<std::uint8_t>& may,
-                            const std::function<bool(const Vec<D>&, const Vec<D>&)>& would_split, std::size_t* across) {
+                            const std::function<bool(const Vec<D>&, const Vec<D>&)>& would_split, std::size_t* across,
+                            MergeGroups groups) {
   ParticleStore<D>& store = sim.store();
   // Across ranks, a family split over them is brought whole to one rank: its members' copies are lent there.
   const DomainT<D>* domain = sim.domain();
   typename DomainT<D>::Lent lent;
   lent.first = store.size();
-  if (domain != nullptr) lent = domain->lend_families(store, may);
-  MergeResultIn<D> m = merge_families<D>(store, may, sim.settings().geometry, sim.time(), would_split, lent.first);
+  if (domain != nullptr) lent = domain->lend_families(store, may, groups, sim.settings().geometry.container.lo);
+  MergeResultIn<D> m =
+      merge_families<D>(store, may, sim.settings().geometry, sim.time(), would_split, lent.first, groups);
   if (domain != nullptr) {
-    const std::size_t n = domain->settle_families(store, lent, m.merged_copies);
-    if (across != nullptr) *across += n;
+    domain->settle_families(store, m.merged_copies, lent);
+    if (across != nullptr) *across += m.merged_with_copies;
   }
   return m;
 }
@@ -93,7 +95,8 @@ bool RefinementStageIn<D>::after_step(SimulationT<D>& sim) {
       if (may[i] && store.level_time[i] > held_since) may[i] = 0;
     }
     const MergeResultIn<D> m = merge_pass<D>(
-        sim, may, [&](const Vec<D>& x, const Vec<D>& v) { return criterion_->would_split(x, v); }, &merged_across_);
+        sim, may, [&](const Vec<D>& x, const Vec<D>& v) { return criterion_->would_split(x, v); }, &merged_across_,
+        settings_.coarsening->groups);
     rec.merged = m.merged;
     rec.merge_d_kinetic = m.d_kinetic;
     rec.merge_d_angular = m.d_angular;
@@ -129,9 +132,11 @@ std::size_t refine_region(SimulationT<D>& sim, const Box<D>& box, Pattern patter
 }
 
 template MergeResultIn<2> merge_pass<2>(SimulationT<2>&, std::vector<std::uint8_t>&,
-                                        const std::function<bool(const Vec<2>&, const Vec<2>&)>&, std::size_t*);
+                                        const std::function<bool(const Vec<2>&, const Vec<2>&)>&, std::size_t*,
+                                        MergeGroups);
 template MergeResultIn<3> merge_pass<3>(SimulationT<3>&, std::vector<std::uint8_t>&,
-                                        const std::function<bool(const Vec<3>&, const Vec<3>&)>&, std::size_t*);
+                                        const std::function<bool(const Vec<3>&, const Vec<3>&)>&, std::size_t*,
+                                        MergeGroups);
 template class RefinementStageIn<2>;
 template class RefinementStageIn<3>;
 template RefinementStageIn<2>& add_refinement_stage<2>(SimulationT<2>&, const RefinementSettings&);

@@ -66,7 +66,7 @@ RefinementStageIn<D>& add_refinement_stage(SimulationT<D>& sim, const Refinement
 template <int D>
 MergeResultIn<D> merge_pass(SimulationT<D>& sim, std::vector<std::uint8_t>& may,
                             const std::function<bool(const Vec<D>&, const Vec<D>&)>& would_split = {},
-                            std::size_t* across = nullptr);
+                            std::size_t* across = nullptr, MergeGroups groups = MergeGroups::family);
 
 /// Static refinement at set-up: splits every fluid particle (fully refined runs) or those in a box, then
 /// refreshes the simulation. Returns how many were split. (2D and 3D.)

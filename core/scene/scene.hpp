@@ -85,6 +85,7 @@ using Slip = GhostSlip;
 // Dynamic refinement and coarsening are the refinement stage's settings (core/refinement/refinement_settings.hpp).
 using Criterion = refine::CriterionKind;
 using Pattern = refine::Pattern;
+using MergeGroups = refine::MergeGroups;
 using Coarsening = refine::CoarseningSettings;
 using Refinement = refine::RefinementSettings;
 
@@ -215,6 +216,7 @@ const char* to_string(Shape v);
 const char* to_string(Slip v);
 const char* to_string(Criterion v);
 const char* to_string(Pattern v);
+const char* to_string(MergeGroups v);
 const char* to_string(ProbeKind v);
 const char* to_string(Outflow v);
 const char* to_string(GhostPressure v);

@@ -49,6 +49,10 @@ struct Choices<Pattern> {
   static constexpr std::array<Choice<Pattern>, 2> table{{{"aap", Pattern::aap}, {"rsp", Pattern::rsp}}};
 };
 template <>
+struct Choices<MergeGroups> {
+  static constexpr std::array<Choice<MergeGroups>, 2> table{{{"family", MergeGroups::family}, {"cell", MergeGroups::cell}}};
+};
+template <>
 struct Choices<TimeStepping> {
   static constexpr std::array<Choice<TimeStepping>, 2> table{
       {{"global", TimeStepping::global}, {"per_level", TimeStepping::per_level}}};

@@ -96,6 +96,8 @@ const S<Coarsening>& coarsening_section() {
               .unit("s")
               .range(Range::non_negative())
               .means("time at its level before a family may merge"));
+    d.add(value<Coarsening>("groups", member(&Coarsening::groups))
+              .means("what merges: the daughters of one parent, or any of one level in a cell of the merged spacing"));
     return d;
   }();
   return s;
