@@ -83,13 +83,41 @@ class Integrator {
   /// one global step, or before any evaluation, its level's (0 with one global step).
   template <int D>
   int bin_for(const ParticleView<D>& s, std::size_t i, double dt0, double cfl) const {
+    return bin_for(s, i, dt0, cfl, s.dt_limit[i]);
+  }
+  /// The same with the limit given (Integrator::neighbourhood_limits' instead of the particle's own).
+  template <int D>
+  int bin_for(const ParticleView<D>& s, std::size_t i, double dt0, double cfl, double limit) const {
     int b = bin(s.level[i]);
-    if (bin_cap() == 0 || !(s.dt_limit[i] > 0.0) || !std::isfinite(dt0)) return b;
-    const double allowed = cfl * s.dt_limit[i];
+    if (bin_cap() == 0 || !(limit > 0.0) || !std::isfinite(dt0)) return b;
+    const double allowed = cfl * limit;
     // dt0 2^-b by the table: a power of two, so the product is exact (as std::ldexp, at a fraction of its cost;
     // this runs nine times per particle and step in Simulation::choose_bins).
     while (b < bin_cap() && dt0 * kBinWeight[static_cast<std::size_t>(b)] > allowed) ++b;
     return b;
+  }
+
+  /// limits[i]: each fluid particle's time-step limit over its kernel neighbourhood, the smallest of its own and each
+  /// fluid, ghost or halo neighbour's (|x_i - x_j| < h_i + h_j), the neighbour's scaled to i's smoothing length
+  /// (dt_j h_i / h_j: a coarse particle is not held to a fine neighbour's shorter reach, only to a stiffer or
+  /// faster one); other entries the store's dt_limit. The store is not changed (its dt_limit stays each particle's
+  /// own, which the coarse step's target uses): the same at any thread count. Called on the grid of the last
+  /// substep, for the bins (per-level steps only). With one global step every particle steps at C times the
+  /// smallest limit of all; with its own limit alone, a particle at the tip of the dam break's surge front,
+  /// stepping at C times its own, went wrong at 4x and 16x (docs/METHOD.md, "the surge front").
+  template <int D>
+  void neighbourhood_limits(const ParticleView<D>& s, const CellGrid<D>& grid, std::vector<double>& limits) const {
+    std::vector<double>& work = limits;
+    work.resize(s.n);
+    par::parallel_for(s.n, [&](std::size_t i) {
+      double m = s.dt_limit[i];
+      if (s.kind[i] == Kind::fluid && m > 0.0) {
+        grid.for_each_neighbour(i, s.x, s.h, [&](std::size_t j, double) {
+          if (s.kind[j] != Kind::wall && s.dt_limit[j] > 0.0) m = std::min(m, s.dt_limit[j] * (s.h[i] / s.h[j]));
+        });
+      }
+      work[i] = m;
+    });
   }
 
   /// The bin limiter, one Jacobi pass: each fluid particle's next bin is raised to at least each fluid or halo

@@ -184,9 +184,12 @@ void SimulationT<D>::refresh() {
   });
   // Levels may have changed (a split or a merge): each particle's bin again, before the rates are evaluated. The
   // ghosts and halos carry their sources' next bins, so they take the same bins.
-  choose_bins();
   prepare_neighbours();
-  limit_bins();
+  if (integrator_.bin_cap() > 0) {
+    choose_bins_on_grid();
+  } else {
+    choose_bins();  // every next bin 0
+  }
   const auto t = store_.view();
   par::parallel_for(t.n, [&](std::size_t i) {
     if (t.kind[i] != Kind::wall) t.bin[i] = t.next_bin[i];
@@ -217,7 +220,7 @@ void SimulationT<D>::count_work(int finest, const SweepLimits& lim) {
 }
 
 template <int D>
-bool SimulationT<D>::choose_bins() {
+bool SimulationT<D>::choose_bins(const std::vector<double>* limits) {
   const auto s = store_.view();
   const Integrator& integ = integrator_;
   const double cfl = settings_.cfl;
@@ -245,7 +248,7 @@ bool SimulationT<D>::choose_bins() {
         Costs c{};
         if (s.kind[i] != Kind::fluid) return c;
         for (std::size_t k = 0; k < K; ++k) {
-          const int b = integ.bin_for(s, i, candidate[k], cfl);
+          const int b = limits ? integ.bin_for(s, i, candidate[k], cfl, (*limits)[i]) : integ.bin_for(s, i, candidate[k], cfl);
           c[k] = std::uint64_t{1} << b;
           c[K + k] = static_cast<std::uint64_t>(b);
         }
@@ -282,12 +285,27 @@ bool SimulationT<D>::choose_bins() {
       s.n, false,
       [&](std::size_t i) {
         if (s.kind[i] != Kind::fluid) return false;
-        s.next_bin[i] = integ.bin_for(s, i, dt0, cfl);
+        s.next_bin[i] = limits ? integ.bin_for(s, i, dt0, cfl, (*limits)[i]) : integ.bin_for(s, i, dt0, cfl);
         return s.next_bin[i] != s.bin[i];
       },
       [](bool a, bool b) { return a || b; });
   if (domain_) changed = domain_->comm().any(changed);
   return changed;
+}
+
+template <int D>
+bool SimulationT<D>::choose_bins_on_grid() {
+  // The limits over each neighbourhood (on the grid just built: the ghosts' and halos' limits are their sources'
+  // latest), the bins from them, the copies' next bins, then the limiter.
+  integrator_.neighbourhood_limits(store_.view(), grid_, limit_work_);
+  bool rebin = choose_bins(&limit_work_);
+  if (domain_) {
+    prepare_neighbours();  // the halos' and ghosts' copies of the next bins
+  } else {
+    copy_next_bins_to_ghosts();
+  }
+  if (limit_bins()) rebin = next_bins_differ();
+  return rebin;
 }
 
 template <int D>
@@ -426,7 +444,7 @@ StepInfo SimulationT<D>::step(double dt_cap) {
     // waits for one that has left the step.
     // Before the last evaluation: each particle's bin for the next step (before the ghosts and halos copy it).
     const bool choose = k == substeps && integ.bin_cap() > 0;
-    bool rebin = choose && choose_bins();
+    bool rebin = false;
     SweepLimits lim;
     try {
       if (renumbered || domain_) {
@@ -434,7 +452,7 @@ StepInfo SimulationT<D>::step(double dt_cap) {
       } else {
         build_neighbours(hr);
       }
-      if (choose && limit_bins()) rebin = next_bins_differ();
+      if (choose) rebin = choose_bins_on_grid();
       Activity act = activity(k, finest);
       act.rebin = rebin;
       lim = sweep_->run(store_.view(), grid_, act);

@@ -236,6 +236,40 @@ TEST(Integrator, BinLimiterEqualsBruteForceAndBoundsNeighbours) {
   }
 }
 
+// Integrator::neighbourhood_limits on the solver's grid against its brute-force twin: on the three-level cloud with
+// random limits, each fluid particle's result is the smallest of its own limit and each non-wall neighbour's scaled
+// by h_i / h_j, exactly; the store's limits are left as they were; and some particles do take a neighbour's.
+TEST(Integrator, NeighbourhoodLimitsEqualBruteForce) {
+  Simulation sim = three_level_cloud(TimeStepping::per_level);
+  sim.remove_ghosts();
+  ParticleStore<2> s = sim.store();
+  CellGrid<2> grid;
+  test::build_level_grid_in_order(s, grid);  // reorders the store by cells
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> U(1e-4, 1e-3);
+  for (std::size_t i = 0; i < s.size(); ++i) s.dt_limit[i] = U(rng);
+  const std::vector<double> own(s.dt_limit.data(), s.dt_limit.data() + s.size());
+  const Integrator integ(TimeStepping::per_level, TaitEquationOfState{});
+  std::vector<double> limits;
+  integ.neighbourhood_limits(s.view(), grid, limits);
+  ASSERT_EQ(limits.size(), s.size());
+  std::size_t taken = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    EXPECT_EQ(s.dt_limit[i], own[i]) << "the store keeps each particle's own limit";
+    double m = own[i];
+    if (s.kind[i] == Kind::fluid) {
+      for (std::size_t j = 0; j < s.size(); ++j) {
+        const double support = s.h[i] + s.h[j];
+        if (j == i || s.kind[j] == Kind::wall || (s.x[i] - s.x[j]).squaredNorm() >= support * support) continue;
+        m = std::min(m, own[j] * (s.h[i] / s.h[j]));
+      }
+    }
+    EXPECT_EQ(limits[i], m) << "particle " << i;
+    taken += limits[i] < own[i];
+  }
+  EXPECT_GT(taken, s.size() / 2) << "random limits: most particles have a neighbour with a shorter one";
+}
+
 // With bin_jump = 1 (the default), over 200 coarse steps of the three-level cloud: after every step no two
 // neighbours' bins differ by more than one; the limiter acted (the run takes more evaluations than with bin_jump = 2,
 // where the daughters at the level jumps that step a bin finer than their level sit two bins from their coarse
