@@ -442,7 +442,8 @@ StepInfo SimulationT<D>::step(double dt_cap) {
     // that is reported (and undone) like any other failure of the step, naming the particle.
     // Distributed, the ranks agree on whether the substep failed before the next collective call, so that no rank
     // waits for one that has left the step.
-    // Before the last evaluation: each particle's bin for the next step (before the ghosts and halos copy it).
+    // Before the last evaluation, on its grid: each particle's bin for the next step (choose_bins_on_grid, which
+    // refreshes the ghosts' and halos' copies of it).
     const bool choose = k == substeps && integ.bin_cap() > 0;
     bool rebin = false;
     SweepLimits lim;
