@@ -75,8 +75,14 @@ bool find_failure(const ParticleStore<D>& store, const Geometry<D>& geometry, do
       std::snprintf(buf, sizeof buf, "density error |rho/rho0 - 1| = %.3g exceeds the limit %.3g",
                     std::abs(store.rho[i] / rho0 - 1.0), settings.max_density_error);
       out.quantity = buf;
-      out.cause = "compression beyond the weakly-compressible range: the sound speed is too low for the flow "
-                  "(raise c0 or the Mach factor) or the time step too large";
+      // The sign says which way the fluid left the weakly-compressible range: a compression and an expansion
+      // point at different causes.
+      out.cause = store.rho[i] >= rho0
+                      ? "compression beyond the weakly-compressible range: the sound speed is too low for the flow "
+                        "(raise c0 or the Mach factor) or the time step too large"
+                      : "expansion beyond the weakly-compressible range: the fluid is pulled apart (a diverging "
+                        "initial velocity, or tension at a free surface or a jump in particle size) faster than "
+                        "its pressure resists (raise c0 or the Mach factor, check the initial velocities)";
       break;
     case 2:
       out.kind = FailureKind::left_domain;

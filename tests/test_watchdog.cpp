@@ -164,6 +164,31 @@ TEST(Watchdog, DensityErrorPastTheLimitIsCaughtAfterGoodSteps) {
   EXPECT_LE(std::abs(sim.store().rho[i] / s.eos.rho0 - 1.0), 0.5) << "the restored particle is within the limit";
 }
 
+TEST(Watchdog, ADensityDeficitIsReportedAsExpansion) {
+  // A block whose velocity diverges from its centre at 4 /s with c0 = 2 m/s: the continuity equation drains
+  // its density by rho div v = 8 rho per second, far faster than the tension of a 2 m/s sound speed can stop,
+  // so |rho/rho0 - 1| passes the limit from below. The report must name an expansion, not a compression.
+  SolverSettings s;
+  s.eos.c0 = 2.0;
+  s.gravity.reset();
+  s.ghosts.reset();
+  s.geometry.container = {Vec<2>(0, 0), Vec<2>(40, 40)};
+  s.watchdog.max_density_error = 0.5;
+  Simulation sim(s);
+  FluidBlockSpec block;
+  block.spacing = 0.5;
+  add_fluid(sim.store(), lattice_rectangle(Vec<2>(15, 15), Vec<2>(25, 25), 0.5), block, s.eos.rho0);
+  const Vec<2> centre(20, 20);
+  for (std::size_t i = 0; i < sim.store().size(); ++i) sim.store().v[i] = 4.0 * (sim.store().x[i] - centre);
+  sim.refresh();
+  const FailureReport r = expect_failure(sim, FailureKind::density, 5000);
+  const std::size_t i = index_of(sim.store(), r.id);
+  ASSERT_LT(i, sim.store().size());
+  EXPECT_NE(r.quantity.find("density error"), std::string::npos) << r.quantity;
+  EXPECT_NE(r.cause.find("expansion"), std::string::npos) << r.cause;
+  EXPECT_EQ(r.cause.find("compression"), std::string::npos) << r.cause;
+}
+
 /// A block of fluid (spacing 0.5) moving at `velocity` in a 10 m x 10 m container with no walls of any kind
 /// (no ghosts, no wall particles) and no gravity.
 Simulation block_in_open_box(const Vec<2>& lo, const Vec<2>& hi, const Vec<2>& velocity, double c0) {
