@@ -175,36 +175,42 @@ TEST(Refinement3D, RotatedPatternPointsAnAxisAtTheReferenceAndScalesByF) {
 }
 
 TEST(Refinement3D, SplitThenMergeGivesBackTheLattice) {
-  sph::Tank3Spec spec;
-  spec.length = 0.4;
-  spec.width = 0.3;
-  spec.depth = 0.2;
-  sph::SimulationT<3> sim = sph::make_still_tank(spec);
-  sim.remove_ghosts();
-  const sph::ParticleStore<3> before = sim.store();
-  sph::refine::refine_all(sim, sph::refine::Pattern::aap, 1.0);
-  sim.remove_ghosts();
-  auto& s = sim.store();
-  ASSERT_EQ(s.size(), 8 * before.size());
-  // Perturb nothing: every family sits as the split left it, so every one merges (the lattice's outer layer is
-  // d/2 from the walls, where the merge rule allows a particle of spacing d).
-  std::vector<std::uint8_t> may(s.size(), 1);
-  const auto r = sph::refine::merge_families<3>(s, may, sim.settings().geometry, 0.0);
-  EXPECT_EQ(r.merged, before.size());
-  EXPECT_EQ(r.kept_off_walls + r.kept_dispersed + r.kept_by_criterion, 0u);
-  ASSERT_EQ(s.size(), before.size());
-  const auto ia = sph::test::index_by_id(before), ib = sph::test::index_by_id(s);
-  for (std::size_t id = 0; id < ia.size(); ++id) {
-    if (ia[id] == static_cast<std::size_t>(-1)) continue;
-    ASSERT_NE(ib[id], static_cast<std::size_t>(-1)) << "the merged particle takes its parent's id back";
-    const std::size_t i = ia[id], j = ib[id];
-    // The mass-weighted mean of eight offsets +-d/4 about x: x up to the rounding of those sums.
-    EXPECT_LE((s.x[j] - before.x[i]).norm(), 1e-12 * before.x[i].norm()) << id;
-    EXPECT_NEAR(s.m[j], before.m[i], 1e-12 * before.m[i]);
-    EXPECT_NEAR(s.rho[j], before.rho[i], 1e-12 * before.rho[i]);
-    EXPECT_EQ(s.h[j], before.h[i]);
-    EXPECT_EQ(s.d[j], before.d[i]);
-    EXPECT_EQ(s.level[j], 0);
+  // Both groupings: the eight daughters of one parent are a family, and on a lattice anchored at the container's
+  // corner they are also the only particles in their parent's cell (coarsening.groups = cell).
+  for (const auto groups : {sph::refine::MergeGroups::family, sph::refine::MergeGroups::cell}) {
+    SCOPED_TRACE(groups == sph::refine::MergeGroups::family ? "groups: family" : "groups: cell");
+    sph::Tank3Spec spec;
+    spec.length = 0.4;
+    spec.width = 0.3;
+    spec.depth = 0.2;
+    sph::SimulationT<3> sim = sph::make_still_tank(spec);
+    sim.remove_ghosts();
+    const sph::ParticleStore<3> before = sim.store();
+    sph::refine::refine_all(sim, sph::refine::Pattern::aap, 1.0);
+    sim.remove_ghosts();
+    auto& s = sim.store();
+    ASSERT_EQ(s.size(), 8 * before.size());
+    // Perturb nothing: every family sits as the split left it, so every one merges (the lattice's outer layer is
+    // d/2 from the walls, where the merge rule allows a particle of spacing d).
+    std::vector<std::uint8_t> may(s.size(), 1);
+    const auto r = sph::refine::merge_families<3>(s, may, sim.settings().geometry, 0.0, {},
+                                                  static_cast<std::size_t>(-1), groups);
+    EXPECT_EQ(r.merged, before.size());
+    EXPECT_EQ(r.kept_off_walls + r.kept_dispersed + r.kept_by_criterion, 0u);
+    ASSERT_EQ(s.size(), before.size());
+    const auto ia = sph::test::index_by_id(before), ib = sph::test::index_by_id(s);
+    for (std::size_t id = 0; id < ia.size(); ++id) {
+      if (ia[id] == static_cast<std::size_t>(-1)) continue;
+      ASSERT_NE(ib[id], static_cast<std::size_t>(-1)) << "the merged particle takes its parent's id back";
+      const std::size_t i = ia[id], j = ib[id];
+      // The mass-weighted mean of eight offsets +-d/4 about x: x up to the rounding of those sums.
+      EXPECT_LE((s.x[j] - before.x[i]).norm(), 1e-12 * before.x[i].norm()) << id;
+      EXPECT_NEAR(s.m[j], before.m[i], 1e-12 * before.m[i]);
+      EXPECT_NEAR(s.rho[j], before.rho[i], 1e-12 * before.rho[i]);
+      EXPECT_EQ(s.h[j], before.h[i]);
+      EXPECT_EQ(s.d[j], before.d[i]);
+      EXPECT_EQ(s.level[j], 0);
+    }
   }
 }
 

@@ -475,7 +475,9 @@ TEST(Coarsening, CellGroupsTakeTheFourLowestIdsAndKeepIdsUniqueOverCycles) {
     s.x[moved][0] += 2 * d1;
     const ParticleId moved_id = s.id[moved];
     for (std::size_t i = 0; i < s.size(); ++i) {
-      if (i != moved && s.x[i][0] > 2.5 && s.x[i][0] < 3.0 && s.x[i][1] < 2.5) ASSERT_LT(moved_id, s.id[i]) << "the premise: the corner family's ids come first";
+      if (i != moved && s.x[i][0] > 2.5 && s.x[i][0] < 3.0 && s.x[i][1] < 2.5) {
+        ASSERT_LT(moved_id, s.id[i]) << "the premise: the corner family's ids come first";
+      }
     }
     const std::size_t n = s.size();
     const refine::MergeResult r = merge(s, all_of(s), g, 1.0, MergeGroups::cell);
