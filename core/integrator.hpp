@@ -85,10 +85,15 @@ class Integrator {
   int bin_for(const ParticleView<D>& s, std::size_t i, double dt0, double cfl) const {
     return bin_for(s, i, dt0, cfl, s.dt_limit[i]);
   }
-  /// The same with the limit given (Integrator::neighbourhood_limits' instead of the particle's own).
+  /// The same with the limit given (a neighbour's, in neighbourhood_bins).
   template <int D>
   int bin_for(const ParticleView<D>& s, std::size_t i, double dt0, double cfl, double limit) const {
-    int b = bin(s.level[i]);
+    return bin_from(bin(s.level[i]), dt0, cfl, limit);
+  }
+  /// The fewest bins from `start` on whose step dt0 / 2^b is within cfl times `limit` (`start` itself when the
+  /// limit is not positive, dt0 not finite, or with one global step). Non-increasing in the limit.
+  int bin_from(int start, double dt0, double cfl, double limit) const {
+    int b = start;
     if (bin_cap() == 0 || !(limit > 0.0) || !std::isfinite(dt0)) return b;
     const double allowed = cfl * limit;
     // dt0 2^-b by the table: a power of two, so the product is exact (as std::ldexp, at a fraction of its cost;
@@ -97,26 +102,54 @@ class Integrator {
     return b;
   }
 
-  /// limits[i]: each fluid particle's time-step limit over its kernel neighbourhood, the smallest of its own and each
-  /// fluid, ghost or halo neighbour's (|x_i - x_j| < h_i + h_j), the neighbour's scaled to i's smoothing length
-  /// (dt_j h_i / h_j: a coarse particle is not held to a fine neighbour's shorter reach, only to a stiffer or
-  /// faster one); other entries the store's dt_limit. The store is not changed (its dt_limit stays each particle's
-  /// own, which the coarse step's target uses): the same at any thread count. Called on the grid of the last
-  /// substep, for the bins (per-level steps only). With one global step every particle steps at C times the
-  /// smallest limit of all; with its own limit alone, a particle at the tip of the dam break's surge front,
-  /// stepping at C times its own, went wrong at 4x and 16x (docs/METHOD.md, "the surge front").
+  /// neighbourhood_bins' workspace, reused from step to step.
+  struct NeighbourhoodWork {
+    par::RangeMax<double> pace;  // -dt_limit_j / h_j of the non-wall particles with a limit, in store order
+  };
+
+  /// Each fluid particle's next bin for the coarse step dt0 from its limit over its kernel neighbourhood: the
+  /// smallest of its own dt_limit and each fluid, ghost or halo neighbour's (|x_i - x_j| < h_i + h_j), the
+  /// neighbour's scaled to i's smoothing length (dt_j h_i / h_j: a coarse particle is not held to a fine
+  /// neighbour's shorter reach, only to a stiffer or faster one): bin_for(dt0, that limit). The store's dt_limit
+  /// stays each particle's own (the coarse step's target uses it). Called on the grid of the last substep (per-level
+  /// steps only). With one global step every particle steps at C times the smallest limit of all; with its own
+  /// limit alone, a particle at the tip of the dam break's surge front, stepping at C times its own, went wrong at
+  /// 4x and 16x (docs/METHOD.md, "the surge front").
+  /// Only a neighbour whose scaled limit is a bin shorter than i's own can change i's bin, and in a region of
+  /// one flow few are: the neighbours are walked only where a lower bound on their scaled limits, from the
+  /// smallest dt_j / h_j in the store and then in i's candidate runs (a range-maximum table, as the limiter's),
+  /// would put i in a finer bin. The result is the same as walking every particle's neighbours.
   template <int D>
-  void neighbourhood_limits(const ParticleView<D>& s, const CellGrid<D>& grid, std::vector<double>& limits) const {
-    std::vector<double>& work = limits;
-    work.resize(s.n);
+  void neighbourhood_bins(const ParticleView<D>& s, const CellGrid<D>& grid, double dt0, double cfl,
+                          NeighbourhoodWork& work) const {
+    const double inf = std::numeric_limits<double>::infinity();
+    work.pace.build(s.n, [&](std::size_t j) {
+      return s.kind[j] != Kind::wall && s.dt_limit[j] > 0.0 ? -(s.dt_limit[j] / s.h[j]) : -inf;
+    });
+    const double slowest = s.n > 0 ? -work.pace.max(0, s.n) : inf;  // the smallest dt_j / h_j in the store
     par::parallel_for(s.n, [&](std::size_t i) {
-      double m = s.dt_limit[i];
-      if (s.kind[i] == Kind::fluid && m > 0.0) {
-        grid.for_each_neighbour(i, s.x, s.h, [&](std::size_t j, double) {
-          if (s.kind[j] != Kind::wall && s.dt_limit[j] > 0.0) m = std::min(m, s.dt_limit[j] * (s.h[i] / s.h[j]));
-        });
-      }
-      work[i] = m;
+      if (s.kind[i] != Kind::fluid) return;
+      const double own = s.dt_limit[i];
+      const int b = bin_for(s, i, dt0, cfl, own);
+      s.next_bin[i] = b;
+      if (!(own > 0.0) || b >= bin_cap()) return;
+      // A lower bound on every computed dt_j (h_i / h_j) with dt_j / h_j >= pace: h_i pace less a few roundings
+      // of the two products and the quotient (1e-12 relative is far beyond them). bin_from is non-increasing in
+      // the limit, so a bound whose bin is not finer than b proves that no such neighbour changes it.
+      const auto finer = [&](double pace) {
+        return std::isfinite(pace) && bin_from(b, dt0, cfl, (s.h[i] * pace) * (1.0 - 1e-12)) > b;
+      };
+      if (!finer(slowest)) return;
+      double pace = inf;
+      grid.for_each_support_run(s.x[i], s.h[i], [&](std::uint32_t lo, std::uint32_t hi) {
+        if (hi > lo) pace = std::min(pace, -work.pace.max(lo, hi));
+      });
+      if (!finer(pace)) return;
+      double m = own;
+      grid.for_each_neighbour(i, s.x, s.h, [&](std::size_t j, double) {
+        if (s.kind[j] != Kind::wall && s.dt_limit[j] > 0.0) m = std::min(m, s.dt_limit[j] * (s.h[i] / s.h[j]));
+      });
+      s.next_bin[i] = bin_for(s, i, dt0, cfl, m);
     });
   }
 

@@ -161,10 +161,11 @@ class SimulationT {
   Activity activity(int k, int finest);
   /// Adds a finished step's work (finest bin, summed limits of its sweeps) to work_.
   void count_work(int finest, const SweepLimits& lim);
-  /// Sets every fluid particle's next_bin (Integrator::bin_for) for the coarse step the cheapest of the
-  /// candidate shares of the levels' target step gives (each particle's bin from limits[i] when given, else its own
-  /// dt_limit); true where any differs from its bin (on any rank).
-  bool choose_bins(const std::vector<double>* limits = nullptr);
+  /// Sets every fluid particle's next_bin for the coarse step the cheapest of the candidate shares of the levels'
+  /// target step gives: from its own dt_limit (Integrator::bin_for), or with `neighbourhoods` from the smallest
+  /// over its neighbourhood on grid_ as built (Integrator::neighbourhood_bins); true where any differs from its
+  /// bin (on any rank).
+  bool choose_bins(bool neighbourhoods = false);
   /// The bin limiter (Integrator::limit_bins) on the grid as built, pass after pass until no next bin changes on
   /// any rank (across ranks, with the halos and ghosts refreshed between passes; in one process the passes read
   /// only the fluid's own bins, and the ghosts copy theirs once at the end); skipped when the fluid's next bins
@@ -173,9 +174,9 @@ class SimulationT {
   /// One process: every ghost's next bin from its source, through the last build's maps (expand_src_,
   /// expand_image_ and the grid's order), instead of a rebuild.
   void copy_next_bins_to_ghosts();
-  /// Per-level steps, on the grid just built: each particle's limit over its neighbourhood
-  /// (Integrator::neighbourhood_limits), choose_bins(), the ghosts' and halos' copies of the next bins, and the
-  /// limiter. True where any next bin differs from its bin (on any rank).
+  /// Per-level steps, on the grid just built: choose_bins() from each particle's limit over its neighbourhood,
+  /// the ghosts' and halos' copies of the next bins, and the limiter. True where any next bin differs from its
+  /// bin (on any rank).
   bool choose_bins_on_grid();
   /// Whether any fluid particle's next bin differs from its bin (on any rank).
   bool next_bins_differ();
@@ -201,7 +202,7 @@ class SimulationT {
   std::vector<std::uint32_t> due_prefix_;  // Activity::due_prefix of the current substep
   Integrator::BinLimiterWork bin_limiter_;  // Integrator::limit_bins' workspace
   std::vector<std::uint32_t> ghost_source_;  // copy_next_bins_to_ghosts: each source's index after the build
-  std::vector<double> limit_work_;           // Integrator::neighbourhood_limits' scratch
+  Integrator::NeighbourhoodWork neighbourhood_work_;  // Integrator::neighbourhood_bins' workspace
   std::vector<std::int8_t> expand_image_;
   std::vector<std::uint8_t> expand_layer_;  // each expanded particle's grid layer (its source's level)
   std::vector<Vec<D>> expand_x_;  // the state before the current step (watchdog rollback)

@@ -220,7 +220,7 @@ void SimulationT<D>::count_work(int finest, const SweepLimits& lim) {
 }
 
 template <int D>
-bool SimulationT<D>::choose_bins(const std::vector<double>* limits) {
+bool SimulationT<D>::choose_bins(bool neighbourhoods) {
   const auto s = store_.view();
   const Integrator& integ = integrator_;
   const double cfl = settings_.cfl;
@@ -231,7 +231,9 @@ bool SimulationT<D>::choose_bins(const std::vector<double>* limits) {
   // The levels' target step, then for each candidate share of it what a coarse step would cost: the evaluations
   // (sum of 2^bin over the fluid) and the substeps' own work (Integrator::kSubstepCost per fluid particle and
   // substep, 2^(finest bin) substeps). The cheapest per unit of time wins. Integer sums and an exact min: the
-  // same at any thread and rank count.
+  // same at any thread and rank count. The costs take each particle's bin from its own limit: the neighbourhoods'
+  // (below) move only a few particles a bin, and walking them for each of the nine candidates cost a fifth of a
+  // run (docs/PERFORMANCE.md, "The neighbourhood limit made cheap").
   double target = par::reduce(
       s.n, std::numeric_limits<double>::infinity(), [&](std::size_t i) { return integ.level_target(s, i, cfl); },
       [](double a, double b) { return std::min(a, b); });
@@ -242,18 +244,18 @@ bool SimulationT<D>::choose_bins(const std::vector<double>* limits) {
   for (std::size_t k = 0; k < K; ++k) candidate[k] = target * Integrator::shrink(static_cast<int>(k));
   // Per candidate k: [k] the evaluations, [K + k] the finest bin; [2K] the fluid count.
   using Costs = std::array<std::uint64_t, 2 * K + 1>;
-  Costs cost = par::reduce(
+  // Folded in place (par::accumulate): a whole Costs built and combined per particle made this pass a few
+  // per cent of a run.
+  Costs cost = par::accumulate(
       s.n, Costs{},
-      [&](std::size_t i) {
-        Costs c{};
-        if (s.kind[i] != Kind::fluid) return c;
+      [&](Costs& c, std::size_t i) {
+        if (s.kind[i] != Kind::fluid) return;
         for (std::size_t k = 0; k < K; ++k) {
-          const int b = limits ? integ.bin_for(s, i, candidate[k], cfl, (*limits)[i]) : integ.bin_for(s, i, candidate[k], cfl);
-          c[k] = std::uint64_t{1} << b;
-          c[K + k] = static_cast<std::uint64_t>(b);
+          const int b = integ.bin_for(s, i, candidate[k], cfl);
+          c[k] += std::uint64_t{1} << b;
+          c[K + k] = std::max(c[K + k], static_cast<std::uint64_t>(b));
         }
-        c[2 * K] = 1;
-        return c;
+        c[2 * K] += 1;
       },
       [](Costs a, const Costs& b) {
         for (std::size_t k = 0; k < K; ++k) {
@@ -281,24 +283,21 @@ bool SimulationT<D>::choose_bins(const std::vector<double>* limits) {
     if (per_time(k) < per_time(best)) best = k;
   }
   const double dt0 = candidate[best];
-  bool changed = par::reduce(
-      s.n, false,
-      [&](std::size_t i) {
-        if (s.kind[i] != Kind::fluid) return false;
-        s.next_bin[i] = limits ? integ.bin_for(s, i, dt0, cfl, (*limits)[i]) : integ.bin_for(s, i, dt0, cfl);
-        return s.next_bin[i] != s.bin[i];
-      },
-      [](bool a, bool b) { return a || b; });
-  if (domain_) changed = domain_->comm().any(changed);
-  return changed;
+  if (neighbourhoods) {
+    integ.neighbourhood_bins(s, grid_, dt0, cfl, neighbourhood_work_);
+  } else {
+    par::parallel_for(s.n, [&](std::size_t i) {
+      if (s.kind[i] == Kind::fluid) s.next_bin[i] = integ.bin_for(s, i, dt0, cfl);
+    });
+  }
+  return next_bins_differ();
 }
 
 template <int D>
 bool SimulationT<D>::choose_bins_on_grid() {
-  // The limits over each neighbourhood (on the grid just built: the ghosts' and halos' limits are their sources'
-  // latest), the bins from them, the copies' next bins, then the limiter.
-  integrator_.neighbourhood_limits(store_.view(), grid_, limit_work_);
-  bool rebin = choose_bins(&limit_work_);
+  // The bins from the limits over each neighbourhood (on the grid just built: the ghosts' and halos' limits are
+  // their sources' latest), the copies' next bins, then the limiter.
+  bool rebin = choose_bins(true);
   if (domain_) {
     prepare_neighbours();  // the halos' and ghosts' copies of the next bins
   } else {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <set>
 #include <vector>
 
 #include "core/cell_grid.hpp"
@@ -236,38 +237,52 @@ TEST(Integrator, BinLimiterEqualsBruteForceAndBoundsNeighbours) {
   }
 }
 
-// Integrator::neighbourhood_limits on the solver's grid against its brute-force twin: on the three-level cloud with
-// random limits, each fluid particle's result is the smallest of its own limit and each non-wall neighbour's scaled
-// by h_i / h_j, exactly; the store's limits are left as they were; and some particles do take a neighbour's.
-TEST(Integrator, NeighbourhoodLimitsEqualBruteForce) {
+// Integrator::neighbourhood_bins on the solver's grid against its brute-force twin: on the three-level cloud, each
+// fluid particle's next bin is bin_for(dt0) of the smallest of its own limit and each non-wall neighbour's scaled
+// by h_i / h_j, exactly; the store's limits are left as they were. Two fields of limits: random over a decade
+// (most particles have a neighbour a bin shorter, and the walk decides) and within 3 % of one value (a calm region:
+// the pre-tests decide for most), each at coarse steps that put the bins at every level and a few finer.
+TEST(Integrator, NeighbourhoodBinsEqualBruteForce) {
   Simulation sim = three_level_cloud(TimeStepping::per_level);
   sim.remove_ghosts();
   ParticleStore<2> s = sim.store();
   CellGrid<2> grid;
   test::build_level_grid_in_order(s, grid);  // reorders the store by cells
-  std::mt19937_64 rng(23);
-  std::uniform_real_distribution<double> U(1e-4, 1e-3);
-  for (std::size_t i = 0; i < s.size(); ++i) s.dt_limit[i] = U(rng);
-  const std::vector<double> own(s.dt_limit.data(), s.dt_limit.data() + s.size());
   const Integrator integ(TimeStepping::per_level, TaitEquationOfState{});
-  std::vector<double> limits;
-  integ.neighbourhood_limits(s.view(), grid, limits);
-  ASSERT_EQ(limits.size(), s.size());
-  std::size_t taken = 0;
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    EXPECT_EQ(s.dt_limit[i], own[i]) << "the store keeps each particle's own limit";
-    double m = own[i];
-    if (s.kind[i] == Kind::fluid) {
-      for (std::size_t j = 0; j < s.size(); ++j) {
-        const double support = s.h[i] + s.h[j];
-        if (j == i || s.kind[j] == Kind::wall || (s.x[i] - s.x[j]).squaredNorm() >= support * support) continue;
-        m = std::min(m, own[j] * (s.h[i] / s.h[j]));
+  Integrator::NeighbourhoodWork work;
+  const double cfl = 0.2;
+  for (const double spread : {0.9, 0.03}) {
+    std::mt19937_64 rng(23);
+    std::uniform_real_distribution<double> U(1.0 - spread, 1.0);
+    for (std::size_t i = 0; i < s.size(); ++i) s.dt_limit[i] = 1e-3 * U(rng);
+    const std::vector<double> own(s.dt_limit.data(), s.dt_limit.data() + s.size());
+    for (const double dt0 : {1e-4, 8e-4, 3e-3, 2e-2}) {
+      SCOPED_TRACE("spread " + std::to_string(spread) + ", dt0 " + std::to_string(dt0));
+      integ.neighbourhood_bins(s.view(), grid, dt0, cfl, work);
+      std::size_t raised = 0, fluid = 0;
+      std::set<std::int32_t> bins;
+      for (std::size_t i = 0; i < s.size(); ++i) {
+        EXPECT_EQ(s.dt_limit[i], own[i]) << "the store keeps each particle's own limit";
+        if (s.kind[i] != Kind::fluid) continue;
+        ++fluid;
+        double m = own[i];
+        for (std::size_t j = 0; j < s.size(); ++j) {
+          const double support = s.h[i] + s.h[j];
+          if (j == i || s.kind[j] == Kind::wall || (s.x[i] - s.x[j]).squaredNorm() >= support * support) continue;
+          m = std::min(m, own[j] * (s.h[i] / s.h[j]));
+        }
+        const int expected = integ.bin_for(s.view(), i, dt0, cfl, m);
+        ASSERT_EQ(s.next_bin[i], expected) << "particle " << i;
+        raised += expected > integ.bin_for(s.view(), i, dt0, cfl);
+        bins.insert(s.next_bin[i]);
       }
+      // The premise of the comparison: the neighbourhood moves some particles, and the bins are not all one.
+      if (dt0 >= 8e-4 && spread > 0.5) {
+        EXPECT_GT(raised, fluid / 10);
+      }
+      EXPECT_GE(bins.size(), 2u);
     }
-    EXPECT_EQ(limits[i], m) << "particle " << i;
-    taken += limits[i] < own[i];
   }
-  EXPECT_GT(taken, s.size() / 2) << "random limits: most particles have a neighbour with a shorter one";
 }
 
 // With bin_jump = 1 (the default), over 200 coarse steps of the three-level cloud: after every step no two
