@@ -279,7 +279,8 @@ TEST(Refinement, DaughtersNeverLandInsideAWallOrOutsideTheDomain) {
                                        Vec<2>(6 - d / 8, 1), Vec<2>(6.5, 3 + d / 8), Vec<2>(7 + 0.01, 3 + 0.01)};
   for (const Vec<2>& xi : parents) {
     refine::Offsets o = refine::axis_aligned_pattern(d);
-    const double margin = 0.25 * d / 2;
+    const double margin = refine::daughter_wall_margin(d);
+    ASSERT_EQ(margin, 0.5 * (d / 2)) << "half the daughters' spacing: where their Lennard-Jones wall force begins";
     const bool shifted = refine::keep_inside_walls(xi, o, walls, margin);
     Vec<2> centroid = Vec<2>::Zero();
     for (const Vec<2>& a : o) {

@@ -105,6 +105,12 @@ OffsetsIn<D> rotated_scaled_pattern(double d_i, const ReferenceIn<D>& ref, doubl
   return oriented_pattern<D>(k * d_i / ref.F, ref.direction);
 }
 
+/// How far inside every wall a daughter of a parent of spacing d must start: half the daughters' spacing d / 2,
+/// where the set-up puts a particle of that spacing and where its Lennard-Jones wall force begins (r0 = d / 2 at
+/// the default r0_factor). A quarter of it, as before 2026-12-02, let RSP put a daughter 0.54 r0 from the drop's
+/// left wall, and the wall's (r0 / r)^12 repulsion threw it out at 194 m/s (docs/METHOD.md, "Daughters near walls").
+inline double daughter_wall_margin(double parent_spacing) { return 0.5 * (0.5 * parent_spacing); }
+
 /// The wall rule (docs/METHOD.md, "Daughters near walls"): every daughter must stay at least `margin` inside
 /// every wall the parent is near. The pattern is first compressed along the wall normal (symmetrically, so the
 /// centroid stays at x_i and conservation is exact), to no less than a quarter of its extent; only if the

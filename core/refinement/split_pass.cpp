@@ -49,7 +49,7 @@ SplitResult split_marked(ParticleStore<D>& store, const std::vector<std::uint8_t
       OffsetsIn<D> o = pattern == Pattern::aap
                       ? axis_aligned_pattern<D>(store.d[i])
                       : rotated_scaled_pattern(store.d[i], find_reference(store, *query, i), rsp_k);
-      shifted[r] = keep_inside_walls(store.x[i], o, walls, 0.25 * (0.5 * store.d[i])) ? 1 : 0;
+      shifted[r] = keep_inside_walls(store.x[i], o, walls, daughter_wall_margin(store.d[i])) ? 1 : 0;
       offsets[r] = o;
     });
   }
