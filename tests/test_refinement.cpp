@@ -4,11 +4,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
 #include <random>
 
 #include "core/case_builder.hpp"
 #include "core/refinement/criteria.hpp"
+#include "core/refinement/family.hpp"
 #include "core/refinement/patterns.hpp"
 #include "core/refinement/refinement_stage.hpp"
 #include "core/refinement/split_pass.hpp"
@@ -412,6 +414,54 @@ TEST_P(CornerZoneDamBreak, EachPassChangesTheTotalEnergyByAtMostAMillionthOfItsS
 }
 
 INSTANTIATE_TEST_SUITE_P(Patterns, CornerZoneDamBreak, ::testing::Values(Pattern::aap, Pattern::rsp));
+
+// A particle whose daughters' ids would not fit (the generations of core/refinement/family.hpp used up, as split-merge
+// cycles in cell groups can do) is left whole by the stage and counted, while the others split; a split asked for
+// directly (split_marked) still refuses with an error.
+TEST(Refinement, AParticleWithoutRoomForItsDaughtersIdsStaysWholeAndIsCounted) {
+  refine::RefinementSettings rs;
+  rs.criterion = refine::CriterionKind::velocity;
+  rs.v_threshold = 1.0;
+  rs.check_interval = 1;
+  rs.max_level = 1;
+  TankSpec spec;
+  Simulation sim = make_still_tank(spec);
+  refine::RefinementStage& stage = refine::add_refinement_stage(sim, rs);
+  auto& s = sim.store();
+  std::size_t fluid = 0, full = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] != Kind::fluid) continue;
+    s.v[i] = Vec<2>(2.0, 0.0);  // every fluid particle is marked
+    // Every fifth: the last generation an id holds (a unique path: the set-up id's, below kMaxRootId).
+    if (fluid++ % 5 == 0) {
+      s.id[i] = (static_cast<ParticleId>(refine::kMaxGenerations) << refine::kGenerationShift) | s.id[i];
+      ++full;
+    }
+  }
+  ASSERT_GT(full, 10u);
+  sim.set_clock(0.0, 0, sim.dt());
+  sim.run_stages();
+  EXPECT_EQ(stage.total_refused(), full);
+  EXPECT_EQ(stage.total_refined(), fluid - full);
+  ASSERT_EQ(stage.log().size(), 1u);
+  EXPECT_EQ(stage.log()[0].refused, full);
+  std::size_t whole = 0, daughters = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] != Kind::fluid) continue;
+    if (s.level[i] == 0) {
+      ++whole;
+      EXPECT_EQ(refine::generation(s.id[i]), refine::kMaxGenerations) << "only the full ids stay whole";
+    } else {
+      ++daughters;
+    }
+  }
+  EXPECT_EQ(whole, full);
+  EXPECT_EQ(daughters, 4 * (fluid - full));
+  std::vector<std::uint8_t> marks(s.size(), 0);
+  for (std::size_t i = 0; i < s.size(); ++i) marks[i] = s.kind[i] == Kind::fluid && s.level[i] == 0;
+  EXPECT_THROW(refine::split_marked(s, marks, Pattern::aap, 1.0, 2, sim.settings().geometry.walls()),
+               std::length_error);
+}
 
 TEST(Refinement, AnyNumberOfLevelsWorks) {
   ParticleStore<2> s = lattice_store(0.5, 0);

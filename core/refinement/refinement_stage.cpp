@@ -1,5 +1,7 @@
 #include "core/refinement/refinement_stage.hpp"
 
+#include "core/refinement/family.hpp"
+
 #include <limits>
 
 namespace sph::refine {
@@ -72,13 +74,21 @@ bool RefinementStageIn<D>::after_step(SimulationT<D>& sim) {
       }
     }
   }
-  bool any = false;
-  for (std::size_t i = 0; i < store.size() && !any; ++i) {
-    any = marks[i] && store.kind[i] == Kind::fluid && store.level[i] < settings_.max_level;
-  }
   PassRecordIn<D> rec;
   rec.step = sim.step_count();
   rec.time = sim.time();
+  // A particle whose daughters' ids would not fit stays whole, and is counted: a split that could not be told
+  // apart from its siblings later would break the families and the id order of every cell.
+  bool any = false;
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    if (!(marks[i] && store.kind[i] == Kind::fluid && store.level[i] < settings_.max_level)) continue;
+    if (has_room_for_daughters<D>(store.id[i])) {
+      any = true;
+    } else {
+      marks[i] = 0;
+      ++rec.refused;
+    }
+  }
   if (any) {
     const SplitResult r = split_marked(store, marks, settings_.pattern, settings_.rsp_k, settings_.max_level,
                                        sim.settings().geometry.walls(), sim.time());
@@ -101,7 +111,8 @@ bool RefinementStageIn<D>::after_step(SimulationT<D>& sim) {
     rec.merge_d_kinetic = m.d_kinetic;
     rec.merge_d_angular = m.d_angular;
   }
-  if (rec.refined == 0 && rec.merged == 0) return false;
+  total_refused_ += rec.refused;
+  if (rec.refined == 0 && rec.merged == 0 && rec.refused == 0) return false;
   total_ += rec.refined;
   total_merged_ += rec.merged;
   rec.per_level = level_counts(store);

@@ -24,6 +24,7 @@ struct PassRecordIn {
   std::size_t refined = 0;
   std::size_t shifted = 0;
   std::size_t merged = 0;     // families merged (2^D into one)
+  std::size_t refused = 0;    // marked, but left whole: a daughter's id would not fit (family.hpp's generations)
   double merge_d_kinetic = 0.0;  // kinetic energy the merges removed (J/m in 2D, J in 3D; <= 0)
   Angular<D> merge_d_angular = zero_angular<D>();  // change of angular momentum by the merges (2D: L_z)
   std::vector<std::size_t> per_level;  // fluid particles per level after the pass
@@ -41,6 +42,9 @@ class RefinementStageIn final : public StageT<D> {
   const std::vector<PassRecordIn<D>>& log() const { return log_; }
   std::size_t total_refined() const { return total_; }
   std::size_t total_merged() const { return total_merged_; }
+  /// Particles marked for a split and left whole because a daughter's id would not fit (kMaxGenerationsIn<D>: in
+  /// cell groups a merged particle keeps a member's generation, so split-merge cycles can use them up).
+  std::size_t total_refused() const { return total_refused_; }
   /// Of those, the families merged on this rank with members lent by others (runs across ranks).
   std::size_t merged_across_ranks() const { return merged_across_; }
 
@@ -51,6 +55,7 @@ class RefinementStageIn final : public StageT<D> {
   std::size_t total_ = 0;
   std::size_t total_merged_ = 0;
   std::size_t merged_across_ = 0;
+  std::size_t total_refused_ = 0;
 };
 
 using RefinementStage = RefinementStageIn<2>;

@@ -13,6 +13,7 @@
 #include "core/io/atomic_file.hpp"
 #include "core/io/hdf5_frames.hpp"
 #include "core/io/time_series.hpp"
+#include "core/refinement/family.hpp"
 #include "core/refinement/refinement_stage.hpp"
 #include "core/scene/scene_builder.hpp"
 #include "core/scene/scene_parser.hpp"
@@ -356,15 +357,22 @@ void RunnerT<D>::write_summary(const Summary& r, const FailureReport* failure) {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   const double peak_rss = comm.max(static_cast<double>(usage.ru_maxrss) * 1024.0);
-  // Dynamic refinement in this invocation: particles split, families merged, and (across ranks) the families
-  // merged with members lent by another rank.
-  std::optional<std::array<std::uint64_t, 3>> passes;
+  // Dynamic refinement in this invocation: particles split, families merged, (across ranks) the families
+  // merged with members lent by another rank, and the splits refused for want of room in a daughter's id.
+  std::optional<std::array<std::uint64_t, 4>> passes;
   for (const auto& stage : sim_.stages()) {
     if (const auto* rs = dynamic_cast<const refine::RefinementStageIn<D>*>(stage.get())) {
-      passes = std::array<std::uint64_t, 3>{comm.sum(std::uint64_t{rs->total_refined()}),
+      passes = std::array<std::uint64_t, 4>{comm.sum(std::uint64_t{rs->total_refined()}),
                                             comm.sum(std::uint64_t{rs->total_merged()}),
-                                            comm.sum(std::uint64_t{rs->merged_across_ranks()})};
+                                            comm.sum(std::uint64_t{rs->merged_across_ranks()}),
+                                            comm.sum(std::uint64_t{rs->total_refused()})};
     }
+  }
+  if (passes && (*passes)[3] > 0 && comm.root()) {
+    std::fprintf(stderr,
+                 "sphrefine: warning: %llu particles marked for a split were left whole: their daughters' ids would "
+                 "not fit (%d generations; with coarsening.groups = \"cell\" each split-merge cycle can add one)\n",
+                 static_cast<unsigned long long>((*passes)[3]), refine::kMaxGenerationsIn<D>);
   }
   if (options_.folder.empty() || !comm.root()) return;
   Json j;
@@ -416,7 +424,7 @@ void RunnerT<D>::write_summary(const Summary& r, const FailureReport* failure) {
   }
   if (passes) {
     j["refinement"] = {{"split", (*passes)[0]}, {"merged_families", (*passes)[1]},
-                       {"merged_families_across_ranks", (*passes)[2]}};
+                       {"merged_families_across_ranks", (*passes)[2]}, {"splits_refused_no_id_room", (*passes)[3]}};
   }
   j["removed_particles"] = r.final.removed;
   j["removed_mass"] = r.final.removed_mass;
