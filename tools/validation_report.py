@@ -488,7 +488,9 @@ def summarise(case, runs, windows):
         s = r["series"]
         mean_n, final_n = mean_count(s)
         row = {"name": name, "wall": r["summary"]["wall_seconds"], "steps": r["summary"]["step"],
-               "timed": r["summary"].get("measured", "before the fix"),
+               # A run the watchdog stopped stores no timings (run_variant): its wall time is that run's own.
+               "timed": r["summary"].get("measured", "stopped: its own run" if r["summary"].get("failure")
+                                         else "before the fix"),
                "mean_n": mean_n, "final_n": final_n,
                "mass_drift": r["summary"]["mass_drift"]}
         failure = r["summary"].get("failure")
