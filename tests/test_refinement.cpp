@@ -457,6 +457,15 @@ TEST(Refinement, AParticleWithoutRoomForItsDaughtersIdsStaysWholeAndIsCounted) {
   }
   EXPECT_EQ(whole, full);
   EXPECT_EQ(daughters, 4 * (fluid - full));
+  // At the next check only the full ids are marked (the daughters are at max_level): the pass is logged, but the
+  // particles did not change, so the stage asks for no refresh.
+  const std::size_t n = s.size();
+  sim.set_clock(0.1, 1, sim.dt());
+  EXPECT_FALSE(stage.after_step(sim));
+  EXPECT_EQ(s.size(), n);
+  EXPECT_EQ(stage.total_refused(), 2 * full);
+  ASSERT_EQ(stage.log().size(), 2u);
+  EXPECT_EQ(stage.log()[1].refined, 0u);
   std::vector<std::uint8_t> marks(s.size(), 0);
   for (std::size_t i = 0; i < s.size(); ++i) marks[i] = s.kind[i] == Kind::fluid && s.level[i] == 0;
   EXPECT_THROW(refine::split_marked(s, marks, Pattern::aap, 1.0, 2, sim.settings().geometry.walls()),

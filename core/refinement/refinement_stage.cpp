@@ -1,8 +1,8 @@
 #include "core/refinement/refinement_stage.hpp"
 
-#include "core/refinement/family.hpp"
-
 #include <limits>
+
+#include "core/refinement/family.hpp"
 
 namespace sph::refine {
 
@@ -112,12 +112,14 @@ bool RefinementStageIn<D>::after_step(SimulationT<D>& sim) {
     rec.merge_d_angular = m.d_angular;
   }
   total_refused_ += rec.refused;
-  if (rec.refined == 0 && rec.merged == 0 && rec.refused == 0) return false;
+  // Only a split or a merge changes the particles (and asks for a refresh); a pass that refused splits is logged.
+  const bool changed = rec.refined > 0 || rec.merged > 0;
+  if (!changed && rec.refused == 0) return false;
   total_ += rec.refined;
   total_merged_ += rec.merged;
   rec.per_level = level_counts(store);
   log_.push_back(std::move(rec));
-  return true;
+  return changed;
 }
 
 template <int D>
