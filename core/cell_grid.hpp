@@ -276,12 +276,14 @@ class CellGrid {
     VecD anchor = VecD::Zero();             // the lattice's origin (the box's corner when not anchored)
     std::array<std::int64_t, D> offset{};  // the first cell's index on that lattice (>= 0)
 
+    /// The cell index along axis k of the coordinate v (clamped into the layer).
+    std::int64_t coord(int k, double v) const {
+      const auto ck = static_cast<std::int64_t>((v - anchor[k]) * inv_cell) - offset[k];
+      return std::clamp<std::int64_t>(ck, 0, dims[k] - 1);
+    }
     std::array<std::int64_t, D> coords(const VecD& p) const {
       std::array<std::int64_t, D> c{};
-      for (int k = 0; k < D; ++k) {
-        auto ck = static_cast<std::int64_t>((p[k] - anchor[k]) * inv_cell) - offset[k];
-        c[k] = std::clamp<std::int64_t>(ck, 0, dims[k] - 1);
-      }
+      for (int k = 0; k < D; ++k) c[k] = coord(k, p[k]);
       return c;
     }
     std::size_t linear(const std::array<std::int64_t, D>& c) const {
@@ -337,12 +339,9 @@ class CellGrid {
         if (d2 <= r2) {
           const double half = std::sqrt(r2 - d2);
           std::int64_t x_lo = lo[0], x_hi = hi[0];
-          if (d2 > 0.0) {
-            VecD a = p, b = p;
-            a[0] -= half;
-            b[0] += half;
-            x_lo = std::max(x_lo, L.coords(a)[0]);
-            x_hi = std::min(x_hi, L.coords(b)[0]);
+          if (d2 > 0.0) {  // only the x index of the clipped row's ends (the same arithmetic as coords())
+            x_lo = std::max(x_lo, L.coord(0, p[0] - half));
+            x_hi = std::min(x_hi, L.coord(0, p[0] + half));
           }
           std::array<std::int64_t, D> row = q;
           row[0] = x_lo;
