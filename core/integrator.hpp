@@ -63,11 +63,13 @@ class Integrator {
   /// A substep's own work per fluid particle, due or not, in units of one particle's force evaluation: the
   /// drift and prediction, the ghosts' expansion, the cell sort and the gather of every field, and the walk of
   /// a particle that is not due over its candidate cells. The bin choice (Simulation::choose_bins) weighs it,
-  /// so that a few stiff particles in a finer bin do not buy every particle twice the substeps. Measured with
-  /// perf on drop_aap per level (docs/PERFORMANCE.md, "Time steps per level"): those parts take 25 % of the
-  /// run over 19,662 substeps of 695 fluid particles on average, the pair sweep 58 % over 6.13e6
-  /// evaluations, a ratio of 0.19; whole runs at 0, 0.25, 0.5 and 1 put the best between 0.25 and 0.5.
-  static constexpr double kSubstepCost = 0.25;
+  /// so that a few stiff particles in a finer bin do not buy every particle twice the substeps. Measured
+  /// (docs/PERFORMANCE.md, "The substeps' cost measured again"): on dam_break_aap per level, two runs with the
+  /// same evaluations (1.507e7 and 1.508e7) and 3,450 substeps apart differ by 2.41 s, 0.45 us per fluid
+  /// particle and substep (1,540 on average); the pair sweep takes 0.70 us per evaluation (perf: 67.5 % of the
+  /// run). 0.45 / 0.70 = 0.65. (It was 0.25, from perf alone, which missed the sweep's walk of the particles that
+  /// are not due.)
+  static constexpr double kSubstepCost = 0.65;
 
   /// The coarse step the levels alone would allow: cfl times the smallest 2^level_i times particle i's limit
   /// without its acoustic stiffness (dt_limit_i s_i: its acoustic limit at h_i, or its force limit if that is
