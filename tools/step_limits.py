@@ -49,10 +49,17 @@ def main():
     ap.add_argument("--coarse")
     ap.add_argument("--every", type=int, default=4, help="every n-th frame")
     args = ap.parse_args()
+    for folder in [args.run] + ([args.coarse] if args.coarse else []):
+        for name in ("scene.json", "series.csv"):
+            if not os.path.isfile(os.path.join(folder, name)):
+                sys.exit(f"{folder}: no {name} (a run folder written by sphrefine run is needed)")
     with open(os.path.join(args.run, "scene.json")) as f:
         scene = json.load(f)
-    cfl = scene["time"]["cfl"]
-    frame_dt = scene["output"]["frame_interval"]
+    try:
+        cfl = scene["time"]["cfl"]
+        frame_dt = scene["output"]["frame_interval"]  # frame k is at t = k frame_dt (a run from t = 0, not resumed)
+    except KeyError as e:
+        sys.exit(f"{args.run}/scene.json: no {e} (time.cfl and output.frame_interval are needed)")
     rows = series_dt(args.run)
     coarse_rows = series_dt(args.coarse) if args.coarse else None
     paths = frames(args.run)
