@@ -1,46 +1,31 @@
 #!/usr/bin/python3
-"""What sets the coarse step of a per-level run, read off its frames (docs/PERFORMANCE.md, "What sets the coarse
-step"): for each frame, the coarse step dt0 (series.csv's dt at the frame's time) and, per level, the smallest
-C 2^l dt_i (the step the level's own limits allow), the same with the acoustic stiffness undone (C 2^l dt_i s_i),
-and how many of the level's particles are stiffer than their own lattice by more than 5 %. With --coarse, the
-coarse-only run's smallest C dt_i at the same frame, the step it took.
+"""What sets the coarse step of a per-level run, read off its frames (docs/PERFORMANCE.md, "The substeps' cost
+measured again, and what sets the coarse step"): for each frame, the coarse step dt0 (series.csv's dt in the row
+nearest the frame's time) and, per level l present, the smallest C 2^l dt_i over its fluid (the step the level's own
+limits allow), the same with the acoustic stiffness undone (C 2^l dt_i s_i), and how many of its particles are
+stiffer than their own lattice by more than 5 %. With --coarse, the coarse-only run's dt at the same time.
 
     /usr/bin/python3 tools/step_limits.py RUN_FOLDER [--coarse COARSE_RUN_FOLDER] [--every 4]
 
-C is read from the run's scene.json (time.cfl). Frames are written at synchronised instants, where every particle
-of a level is in its level's bin or a finer one.
+C is the run's time.cfl (scene.json). Frames are written at synchronised instants, where every particle of a level
+is in its level's bin or a finer one.
 """
 import argparse
-import csv
-import glob
 import json
 import os
 import sys
 
-import h5py
 import numpy as np
 
-FLUID = 0  # Kind::fluid
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from read_output import KIND_NAMES, frame_files, load_frame, load_series  # noqa: E402
+
+FLUID = next(k for k, name in KIND_NAMES.items() if name == "fluid")
 
 
-def frames(folder):
-    return sorted(glob.glob(os.path.join(folder, "frames", "frame_*.h5")))
-
-
-def read(path):
-    with h5py.File(path, "r") as f:
-        g = f[next(iter(f.keys()))]
-        fluid = g["kind"][:] == FLUID
-        return {k: g[k][:][fluid] for k in ("level", "time_bin", "time_step_limit", "acoustic_stiffness")}
-
-
-def series_dt(folder):
-    with open(os.path.join(folder, "series.csv")) as f:
-        return [(float(r["time"]), float(r["dt"])) for r in csv.DictReader(f)]
-
-
-def dt_at(rows, t):
-    return min(rows, key=lambda r: abs(r[0] - t))[1]
+def dt_at(series, t):
+    """series.csv's dt in the row nearest time t."""
+    return float(series["dt"][int(np.argmin(np.abs(series["time"] - t)))])
 
 
 def main():
@@ -54,38 +39,39 @@ def main():
             if not os.path.isfile(os.path.join(folder, name)):
                 sys.exit(f"{folder}: no {name} (a run folder written by sphrefine run is needed)")
     with open(os.path.join(args.run, "scene.json")) as f:
-        scene = json.load(f)
-    try:
-        cfl = scene["time"]["cfl"]
-        frame_dt = scene["output"]["frame_interval"]  # frame k is at t = k frame_dt (a run from t = 0, not resumed)
-    except KeyError as e:
-        sys.exit(f"{args.run}/scene.json: no {e} (time.cfl and output.frame_interval are needed)")
-    rows = series_dt(args.run)
-    coarse_rows = series_dt(args.coarse) if args.coarse else None
-    paths = frames(args.run)
+        cfl = json.load(f).get("time", {}).get("cfl")
+    if cfl is None:
+        sys.exit(f"{args.run}/scene.json: no time.cfl")
+    series = load_series(args.run)
+    coarse = load_series(args.coarse) if args.coarse else None
+    paths = frame_files(args.run)
     if not paths:
         sys.exit(f"{args.run}: no frames")
+    frames = [load_frame(p) for p in paths[::args.every]]
+    fluid = [fr["fields"]["kind"] == FLUID for fr in frames]
+    levels = sorted({int(l) for fr, f in zip(frames, fluid) for l in np.unique(fr["fields"]["level"][f])})
     header = "| t (s) | dt0 | " + " | ".join(
-        f"L{l}: min C 2^l dt_i, with s_i undone, stiff > 1.05" for l in (0, 1)) + " |"
-    if args.coarse:
+        f"L{l}: min C 2^l dt_i, with s_i undone, stiff > 1.05" for l in levels) + " |"
+    if coarse is not None:
         header += " coarse-only run: dt |"
     print(header)
     print("|" + "---|" * (header.count("|") - 1))
-    for k in range(0, len(paths), args.every):
-        t = k * frame_dt
-        fr = read(paths[k])
-        cells = [f"{t:.1f}", f"{dt_at(rows, t):.3e}"]
-        for level in (0, 1):
-            m = fr["level"] == level
+    for fr, f in zip(frames, fluid):
+        t = float(fr["time"])
+        level = fr["fields"]["level"][f]
+        limit = fr["fields"]["time_step_limit"][f]
+        stiffness = fr["fields"]["acoustic_stiffness"][f]
+        cells = [f"{t:.1f}", f"{dt_at(series, t):.3e}"]
+        for l in levels:
+            m = level == l
             if not m.any():
                 cells.append("-")
                 continue
-            own = cfl * (2.0 ** level) * fr["time_step_limit"][m]
-            undone = own * fr["acoustic_stiffness"][m]
-            stiff = int((fr["acoustic_stiffness"][m] > 1.05).sum())
-            cells.append(f"{own.min():.3e}, {undone.min():.3e}, {stiff} of {int(m.sum())}")
-        if coarse_rows:
-            cells.append(f"{dt_at(coarse_rows, t):.3e}")
+            own = cfl * (2.0 ** l) * limit[m]
+            undone = own * stiffness[m]
+            cells.append(f"{own.min():.3e}, {undone.min():.3e}, {int((stiffness[m] > 1.05).sum())} of {int(m.sum())}")
+        if coarse is not None:
+            cells.append(f"{dt_at(coarse, t):.3e}")
         print("| " + " | ".join(cells) + " |")
 
 
