@@ -200,6 +200,7 @@ class SimulationT {
   // Step workspace of prepare_neighbours (reused, so a step allocates nothing once sizes settle).
   std::vector<std::uint32_t> expand_src_, expand_offsets_;
   std::vector<std::uint32_t> due_prefix_;  // Activity::due_prefix of the current substep
+  std::vector<std::uint32_t> due_index_;   // Activity::due_index of the current substep
   Integrator::BinLimiterWork bin_limiter_;  // Integrator::limit_bins' workspace
   std::vector<std::uint32_t> ghost_source_;  // copy_next_bins_to_ghosts: each source's index after the build
   Integrator::NeighbourhoodWork neighbourhood_work_;  // Integrator::neighbourhood_bins' workspace

@@ -383,7 +383,12 @@ Activity SimulationT<D>::activity(int k, int finest) {
     due_prefix_[i] = s.kind[i] != Kind::wall && act.bin(s.bin[i]) >= act.active_bin ? 1u : 0u;
   });
   due_prefix_[s.n] = par::exclusive_scan(due_prefix_.data(), due_prefix_.data(), s.n);
+  due_index_.resize(due_prefix_[s.n]);
+  par::parallel_for(s.n, [&](std::size_t i) {
+    if (due_prefix_[i + 1] != due_prefix_[i]) due_index_[due_prefix_[i]] = static_cast<std::uint32_t>(i);
+  });
   act.due_prefix = due_prefix_.data();
+  act.due_index = due_index_.data();
   return act;
 }
 

@@ -66,6 +66,10 @@ struct Activity {
   // Optional, with active_bin > 0: due_prefix[k] counts the due particles (fluid or ghost, bin >= active_bin)
   // among the first k of the store. A particle that is not due skips every candidate run without one.
   const std::uint32_t* due_prefix = nullptr;
+  // Optional, with due_prefix: the store indices of the due particles in store order, so that the due particles of
+  // a run [b, e) are due_index[due_prefix[b] .. due_prefix[e]). A particle that is not due then walks only those,
+  // in the same order as the run's: the same pairs and sums, without the candidates that cannot pair with it.
+  const std::uint32_t* due_index = nullptr;
   int bin(std::int32_t b) const { return b < bin_cap ? static_cast<int>(b) : bin_cap; }
 };
 
@@ -123,10 +127,16 @@ class PairSweep {
           // A particle that is not due only meets due ones: it skips a layer (a level) or a run without any.
           const bool all = due || act.due_prefix == nullptr;
           const auto holds_due = [&](std::uint32_t b, std::uint32_t e) { return all || act.due_prefix[e] != act.due_prefix[b]; };
+          // Only the due candidates of a run when i is not due and their list is there: a pair with i is due only
+          // when j is (b_ij = b_j >= active bin), and walls pair only with due particles.
+          const bool due_only = !all && act.due_index != nullptr;
           grid.for_each_support_run(xi, hi, [&](std::uint32_t b, std::uint32_t e) {
             if (!holds_due(b, e)) return;
-            candidates += e - b;
-            for (std::uint32_t j = b; j < e; ++j) {
+            const std::uint32_t first = due_only ? act.due_prefix[b] : b;
+            const std::uint32_t last = due_only ? act.due_prefix[e] : e;
+            candidates += last - first;
+            for (std::uint32_t q = first; q < last; ++q) {
+              const std::uint32_t j = due_only ? act.due_index[q] : q;
               const Vec<D> xij = xi - s.x[j];
               const double r2 = xij.squaredNorm();
               const double support = hi + s.h[j];

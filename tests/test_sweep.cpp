@@ -208,14 +208,22 @@ TEST(Sweep, TimeBinsEqualBruteForce) {
       build_grid(s, grid);
     }
     for (const int active : {2, 1, 0}) {
-      for (const bool skip : {false, true}) {
-        SCOPED_TRACE(testing::Message() << "active bin " << active << (skip ? ", with the prefix" : "")
+      // The kicks and candidates of each variant: none, the prefix, the prefix and the due list.
+      std::vector<std::vector<Vec<2>>> kicks;
+      std::vector<std::uint64_t> candidates;
+      for (const int skip : {0, 1, 2}) {
+        SCOPED_TRACE(testing::Message() << "active bin " << active
+                                        << (skip == 1 ? ", with the prefix" : (skip == 2 ? ", with the due list" : ""))
                                         << (layered ? ", a layer per level" : ", one grid"));
         sph::Activity act{active, sph::Integrator::kMaxBin};
-        std::vector<std::uint32_t> prefix(s.size() + 1, 0);
-        for (std::size_t i = 0; i < s.size(); ++i)
-          prefix[i + 1] = prefix[i] + (s.kind[i] != Kind::wall && act.bin(s.bin[i]) >= active ? 1u : 0u);
-        if (skip) act.due_prefix = prefix.data();
+        std::vector<std::uint32_t> prefix(s.size() + 1, 0), due;
+        for (std::size_t i = 0; i < s.size(); ++i) {
+          const bool is_due = s.kind[i] != Kind::wall && act.bin(s.bin[i]) >= active;
+          prefix[i + 1] = prefix[i] + (is_due ? 1u : 0u);
+          if (is_due) due.push_back(static_cast<std::uint32_t>(i));
+        }
+        if (skip >= 1) act.due_prefix = prefix.data();
+        if (skip == 2) act.due_index = due.data();
         const Vec<2> sentinel(1234.5, -6789.0);
         for (std::size_t i = 0; i < s.size(); ++i) {
           s.a[i] = sentinel;
@@ -236,6 +244,24 @@ TEST(Sweep, TimeBinsEqualBruteForce) {
           EXPECT_GT(touched, 20u) << "coarser particles take the impulses of their due neighbours";
           EXPECT_EQ(lim.finest_bin, 2);
         }
+        kicks.emplace_back(s.kick.values().begin(), s.kick.values().end());
+        candidates.push_back(lim.candidates);
+      }
+      // The prefix and the due list only skip candidates that cannot pair: the same sums, bit for bit, in the same
+      // order; with some particles not due, each skips some.
+      EXPECT_EQ(kicks[1], kicks[0]);
+      EXPECT_EQ(kicks[2], kicks[0]);
+      if (active > 0) {
+        EXPECT_LE(candidates[1], candidates[0]);
+        // With a layer per level every particle of a due layer is due here (each level in its own bin): the list
+        // has nothing more to skip. In one grid the runs mix the levels.
+        if (layered) {
+          EXPECT_EQ(candidates[2], candidates[1]);
+        } else {
+          EXPECT_LT(candidates[2], candidates[1]);
+        }
+      } else {
+        EXPECT_EQ(candidates[2], candidates[0]);
       }
     }
   }
