@@ -119,8 +119,9 @@ class Integrator {
   /// 4x and 16x (docs/METHOD.md, "the surge front").
   /// Only a neighbour whose scaled limit is a bin shorter than i's own can change i's bin, and in a region of
   /// one flow few are: the neighbours are walked only where a lower bound on their scaled limits, from the
-  /// smallest dt_j / h_j in the store and then in i's candidate runs (a range-maximum table, as the limiter's),
-  /// would put i in a finer bin. The result is the same as walking every particle's neighbours.
+  /// smallest dt_j / h_j in the store and then in each of i's candidate runs (a range-maximum table, as the
+  /// limiter's), would put i in a finer bin: only those runs are walked. The result is the same as walking every
+  /// particle's neighbours.
   template <int D>
   void neighbourhood_bins(const ParticleView<D>& s, const CellGrid<D>& grid, double dt0, double cfl,
                           NeighbourhoodWork& work) const {
@@ -142,14 +143,19 @@ class Integrator {
         return std::isfinite(pace) && bin_from(b, dt0, cfl, (s.h[i] * pace) * (1.0 - 1e-12)) > b;
       };
       if (!finer(slowest)) return;
-      double pace = inf;
-      grid.for_each_support_run(s.x[i], s.h[i], [&](std::uint32_t lo, std::uint32_t hi) {
-        if (hi > lo) pace = std::min(pace, -work.pace.max(lo, hi));
-      });
-      if (!finer(pace)) return;
+      // One scan of the candidate runs: a run is walked only where its bound would put i in a finer bin. A
+      // neighbour in a run that is not walked has a scaled limit whose bin is not finer than b, so it cannot change
+      // the bin, which is the finest over i's own limit and each neighbour's (bin_from is non-increasing).
       double m = own;
-      grid.for_each_neighbour(i, s.x, s.h, [&](std::size_t j, double) {
-        if (s.kind[j] != Kind::wall && s.dt_limit[j] > 0.0) m = std::min(m, s.dt_limit[j] * (s.h[i] / s.h[j]));
+      const Vec<D> xi = s.x[i];
+      const double hi = s.h[i];
+      grid.for_each_support_run(xi, hi, [&](std::uint32_t lo, std::uint32_t up) {
+        if (up <= lo || !finer(-work.pace.max(lo, up))) return;
+        for (std::uint32_t j = lo; j < up; ++j) {
+          if (j == i || s.kind[j] == Kind::wall || !(s.dt_limit[j] > 0.0)) continue;
+          const double support = hi + s.h[j];
+          if ((xi - s.x[j]).squaredNorm() < support * support) m = std::min(m, s.dt_limit[j] * (hi / s.h[j]));
+        }
       });
       s.next_bin[i] = bin_for(s, i, dt0, cfl, m);
     });
@@ -167,10 +173,9 @@ class Integrator {
   /// result does not depend on the order or the threads. Returns whether any changed on this store. Repeated
   /// (with the halos' copies refreshed between passes) until none changes, every pair of neighbours ends at most
   /// bin_jump bins apart, at the coarsest such bins above those chosen.
-  /// A particle is first tested against the largest next bin in its candidate runs (the store ranges the grid
-  /// scans for it, a superset of its neighbours), in constant time a run (par::RangeMax), and before that against
-  /// the largest next bin in the store; only where that bin is more than bin_jump above its own are the
-  /// neighbours themselves walked. The result is the same as walking every particle's neighbours; most
+  /// A particle is first tested against the largest next bin in the store, then against the largest in each of
+  /// its candidate runs (the store ranges the grid scans for it, a superset of its neighbours), in constant time a
+  /// run (par::RangeMax); only the runs whose largest is more than bin_jump above its own are walked. The result is the same as walking every particle's neighbours; most
   /// particles, in a region of one bin, skip the walk.
   template <int D>
   bool limit_bins(const ParticleView<D>& s, const CellGrid<D>& grid, BinLimiterWork& work) const {
@@ -187,14 +192,18 @@ class Integrator {
         [&](std::size_t i) {
           raised[i] = s.next_bin[i];
           if (s.kind[i] != Kind::fluid || top - bin_jump_ <= s.next_bin[i]) return false;
-          std::int32_t reach = -1;
-          grid.for_each_support_run(s.x[i], s.h[i], [&](std::uint32_t b, std::uint32_t e) {
-            if (e > b) reach = std::max<std::int32_t>(reach, work.reach.max(b, e));
-          });
-          if (reach - bin_jump_ <= s.next_bin[i]) return false;
+          // One scan of the candidate runs: a run is walked only where its largest next bin is more than bin_jump
+          // above i's (no particle of another run can raise it).
           std::int32_t need = s.next_bin[i];
-          grid.for_each_neighbour(i, s.x, s.h, [&](std::size_t j, double) {
-            if (s.kind[j] == Kind::fluid || s.kind[j] == Kind::halo) need = std::max(need, s.next_bin[j] - bin_jump_);
+          const Vec<D> xi = s.x[i];
+          const double hi = s.h[i];
+          grid.for_each_support_run(xi, hi, [&](std::uint32_t b, std::uint32_t e) {
+            if (e <= b || work.reach.max(b, e) - bin_jump_ <= s.next_bin[i]) return;
+            for (std::uint32_t j = b; j < e; ++j) {
+              if (j == i || (s.kind[j] != Kind::fluid && s.kind[j] != Kind::halo)) continue;
+              const double support = hi + s.h[j];
+              if ((xi - s.x[j]).squaredNorm() < support * support) need = std::max(need, s.next_bin[j] - bin_jump_);
+            }
           });
           raised[i] = std::min<std::int32_t>(need, bin_cap());
           return raised[i] != s.next_bin[i];
