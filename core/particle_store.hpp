@@ -10,6 +10,7 @@
 #include "core/field.hpp"
 #include "core/types.hpp"
 #include "parallel/compaction.hpp"
+#include "parallel/parallel_for.hpp"
 
 namespace sph {
 
@@ -148,14 +149,19 @@ class ParticleStore {
   void gather(std::size_t new_size, Src&& src) {
     for_each_field([&](auto& f) { f.prepare_gather(new_size); });
     const auto count = static_cast<std::ptrdiff_t>(new_size);
-#pragma omp parallel
-    {
+    const auto fields = [&] {
       for_each_field([&](auto& f) {
         auto* out = f.gather_scratch();
         const auto* in = f.data();
 #pragma omp for schedule(static) nowait
         for (std::ptrdiff_t k = 0; k < count; ++k) out[k] = in[src(static_cast<std::size_t>(k))];
       });
+    };
+    if (par::serial(new_size)) {  // one thread: no region (the orphaned loops run on this thread)
+      fields();
+    } else {
+#pragma omp parallel
+      fields();
     }
     for_each_field([&](auto& f) { f.gather_commit(); });
   }

@@ -45,9 +45,9 @@ void counting_sort(std::size_t n, std::size_t buckets, Key&& key, CountingSortRe
   std::uint32_t* t = scratch.data();
   // One parallel region for the whole sort (each region costs a fork and a join); the worksharing loops'
   // barriers order the phases: histogram, scan of the table (block totals, their serial scan, offsets),
-  // bucket starts, stable scatter.
-#pragma omp parallel
-  {
+  // bucket starts, stable scatter. With one thread, or one chunk and one block of the table, no region: the
+  // orphaned worksharing runs on the calling thread alone.
+  const auto phases = [&] {
 #pragma omp for schedule(dynamic, 1)
     for (std::ptrdiff_t c = 0; c < n_chunks; ++c) {
       const auto cc = static_cast<std::size_t>(c);
@@ -69,6 +69,12 @@ void counting_sort(std::size_t n, std::size_t buckets, Key&& key, CountingSortRe
       const std::size_t end = std::min(n, (cc + 1) * chunk);
       for (std::size_t i = cc * chunk; i < end; ++i) out.order[t[keys[i] * chunks + cc]++] = static_cast<std::uint32_t>(i);
     }
+  };
+  if (serial(std::max(chunks, blocks))) {
+    phases();
+  } else {
+#pragma omp parallel
+    phases();
   }
 }
 

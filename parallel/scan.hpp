@@ -46,9 +46,14 @@ T exclusive_scan(const T* in, T* out, std::size_t n) {
   std::vector<T>& total = buffer;
   total.assign(chunks + 1, T{});
   T* t = total.data();
-  // One parallel region (each costs a fork and a join).
+  // One parallel region (each costs a fork and a join); none for one chunk or one thread, where the orphaned
+  // worksharing runs on the calling thread alone.
+  if (serial(chunks)) {
+    team_exclusive_scan(in, out, n, t);
+  } else {
 #pragma omp parallel
-  team_exclusive_scan(in, out, n, t);
+    team_exclusive_scan(in, out, n, t);
+  }
   return total[chunks];
 }
 
