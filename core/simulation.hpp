@@ -12,7 +12,8 @@
 // output counts and h range (one loop); 2. the scan of the counts; 3. the expansion with its bounding box; 4. the
 // cell sort (one region, its phases separated by barriers); 5. the gather of every field through the composed
 // map; 6. the ghosts' values; 7. the pair sweep. Then per step: 8. the closing kick; 9. the watchdog's scan.
-// With one global step that is 9 regions per step (there were 19).
+// With one global step that is 9 regions per step (there were 19). With one thread there are none: each runs on
+// the calling thread (par::serial).
 #include <array>
 #include <memory>
 #include <optional>
