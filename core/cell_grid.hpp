@@ -252,9 +252,16 @@ class CellGrid {
   /// Calls f(j, r2) for every j != i with |x_i - x_j| < h_i + h_j (= 2 h_ij), in a fixed order.
   template <class F>
   void for_each_neighbour(std::size_t i, const VecD* x, const double* h, F&& f) const {
+    for_each_neighbour_in(i, x, h, [](std::uint32_t, std::uint32_t) { return true; }, f);
+  }
+  /// for_each_neighbour, walking only the candidate runs [b, e) for which walk(b, e) holds: for a caller that can
+  /// tell from a run's range (a range table over the store order) that none of its particles matters.
+  template <class Walk, class F>
+  void for_each_neighbour_in(std::size_t i, const VecD* x, const double* h, Walk&& walk, F&& f) const {
     const VecD xi = x[i];
     const double hi = h[i];
     for_each_support_run(xi, hi, [&](std::uint32_t b, std::uint32_t e) {
+      if (!walk(b, e)) return;
       for (std::uint32_t j = b; j < e; ++j) {
         if (j == i) continue;
         const double r2 = (xi - x[j]).squaredNorm();

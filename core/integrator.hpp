@@ -147,16 +147,11 @@ class Integrator {
       // neighbour in a run that is not walked has a scaled limit whose bin is not finer than b, so it cannot change
       // the bin, which is the finest over i's own limit and each neighbour's (bin_from is non-increasing).
       double m = own;
-      const Vec<D> xi = s.x[i];
-      const double hi = s.h[i];
-      grid.for_each_support_run(xi, hi, [&](std::uint32_t lo, std::uint32_t up) {
-        if (up <= lo || !finer(-work.pace.max(lo, up))) return;
-        for (std::uint32_t j = lo; j < up; ++j) {
-          if (j == i || s.kind[j] == Kind::wall || !(s.dt_limit[j] > 0.0)) continue;
-          const double support = hi + s.h[j];
-          if ((xi - s.x[j]).squaredNorm() < support * support) m = std::min(m, s.dt_limit[j] * (hi / s.h[j]));
-        }
-      });
+      grid.for_each_neighbour_in(
+          i, s.x, s.h, [&](std::uint32_t lo, std::uint32_t up) { return up > lo && finer(-work.pace.max(lo, up)); },
+          [&](std::size_t j, double) {
+            if (s.kind[j] != Kind::wall && s.dt_limit[j] > 0.0) m = std::min(m, s.dt_limit[j] * (s.h[i] / s.h[j]));
+          });
       s.next_bin[i] = bin_for(s, i, dt0, cfl, m);
     });
   }
@@ -175,8 +170,8 @@ class Integrator {
   /// bin_jump bins apart, at the coarsest such bins above those chosen.
   /// A particle is first tested against the largest next bin in the store, then against the largest in each of
   /// its candidate runs (the store ranges the grid scans for it, a superset of its neighbours), in constant time a
-  /// run (par::RangeMax); only the runs whose largest is more than bin_jump above its own are walked. The result is the same as walking every particle's neighbours; most
-  /// particles, in a region of one bin, skip the walk.
+  /// run (par::RangeMax); only the runs whose largest is more than bin_jump above its own are walked. The result
+  /// is the same as walking every particle's neighbours; most particles, in a region of one bin, skip the walk.
   template <int D>
   bool limit_bins(const ParticleView<D>& s, const CellGrid<D>& grid, BinLimiterWork& work) const {
     static_assert(kBinCount <= 127, "next bins are held as int8 in the range table");
@@ -195,15 +190,11 @@ class Integrator {
           // One scan of the candidate runs: a run is walked only where its largest next bin is more than bin_jump
           // above i's (no particle of another run can raise it).
           std::int32_t need = s.next_bin[i];
-          const Vec<D> xi = s.x[i];
-          const double hi = s.h[i];
-          grid.for_each_support_run(xi, hi, [&](std::uint32_t b, std::uint32_t e) {
-            if (e <= b || work.reach.max(b, e) - bin_jump_ <= s.next_bin[i]) return;
-            for (std::uint32_t j = b; j < e; ++j) {
-              if (j == i || (s.kind[j] != Kind::fluid && s.kind[j] != Kind::halo)) continue;
-              const double support = hi + s.h[j];
-              if ((xi - s.x[j]).squaredNorm() < support * support) need = std::max(need, s.next_bin[j] - bin_jump_);
-            }
+          const auto walk = [&](std::uint32_t b, std::uint32_t e) {
+            return e > b && work.reach.max(b, e) - bin_jump_ > s.next_bin[i];
+          };
+          grid.for_each_neighbour_in(i, s.x, s.h, walk, [&](std::size_t j, double) {
+            if (s.kind[j] == Kind::fluid || s.kind[j] == Kind::halo) need = std::max(need, s.next_bin[j] - bin_jump_);
           });
           raised[i] = std::min<std::int32_t>(need, bin_cap());
           return raised[i] != s.next_bin[i];
