@@ -10,7 +10,10 @@
 //   open:   vh = v + (dt0 2^-b / 2) a,  rhoh = rho + (dt0 2^-b / 2) drho       (a, drho: the last rates)
 //   for k = 1..K:
 //     drift:   x += tau vh for every fluid particle, and the prediction where it is needed:
-//              v = vh + (t_k - t_mid) a, rho = rhoh + (t_k - t_mid) drho, t_mid the middle of i's own step
+//              v = vh + (t_k - t_mid) a + e (t_k - t_n)^2 / 2 jerk, and the same for rho with drho and its jerk;
+//              t_n and t_mid the start and middle of i's own step, e = 1 with time.predictor = "extrapolated" (the
+//              rates extrapolated linearly from the particle's last two evaluations: jerk = their difference over
+//              the time between them, core/sweep.hpp), 0 with "last_rate" (the last evaluation's rates held)
 //     forces:  the pairs with b_ij >= the active bin of substep k (core/sweep.hpp), each weighted by 2^-b_ij
 //     kick:    k < K:  vh += dt0 kick, rhoh += dt0 kick_rho  (a closing and an opening half-kick at once)
 //              k = K:  v = vh + (dt0 / 2) kick, rho = rhoh + (dt0 / 2) kick_rho  (every pair closes)
@@ -22,8 +25,11 @@
 // members at the same instant, equal and opposite and along x_ij, so linear and angular momentum are exact to
 // rounding whatever the bins. With bin_cap = 0 (B = 0, K = 1) it is, operation for operation, the single-rate
 // scheme:
-//   v_h = v_n + dt/2 a_n,  x_{n+1} = x_n + dt v_h,  forces at x_{n+1} with v = v_h + dt/2 a_n,
+//   v_h = v_n + dt/2 a_n,  x_{n+1} = x_n + dt v_h,  forces at x_{n+1} with v = v_h + dt/2 a_n + e dt/2 (a_n - a_{n-1}),
 //   v_{n+1} = v_h + dt/2 a_{n+1}   (and the same for rho).
+// The prediction is the only place the two predictors differ; the kicks, and so every conservation property, are
+// the same. For an acoustic mode of frequency omega (z = omega dt) the last-rate prediction grows the mode by about
+// z^4/4 a step, the extrapolated one damps it (by about z^4/2) up to z = 0.67 (docs/METHOD.md, "The predictor").
 // Coarse particles take their own pairs' forces once per coarse step; the pairs they share with finer ones are
 // evaluated at the finer rate, from both sides. Steps end with every bin synchronised, so refinement,
 // coarsening, output and checkpoints only ever see synchronised particles.
@@ -48,10 +54,12 @@ class Integrator {
   static constexpr int kMaxBin = kBinCount - 1;
   static_assert(kMaxBin < 31, "1 << bins must fit an int");
 
-  Integrator(TimeStepping mode, TaitEquationOfState eos, int bin_jump = kDefaultBinJump)
-      : mode_(mode), eos_(eos), bin_jump_(bin_jump) {}
+  Integrator(TimeStepping mode, TaitEquationOfState eos, int bin_jump = kDefaultBinJump,
+             TimePredictor predictor = TimePredictor::extrapolated)
+      : mode_(mode), eos_(eos), bin_jump_(bin_jump), predictor_(predictor) {}
 
   TimeStepping mode() const { return mode_; }
+  TimePredictor predictor() const { return predictor_; }
   int bin_cap() const { return mode_ == TimeStepping::global ? 0 : kMaxBin; }
   int bin(std::int32_t b) const { return Activity{0, bin_cap()}.bin(b); }
   int bin_jump() const { return bin_jump_; }
@@ -230,8 +238,17 @@ class Integrator {
     const int period = 1 << (finest - bin(s.bin[i]));  // substeps per step of i's bin
     const int start = ((k - 1) / period) * period;       // substep at which i's current step began
     const double offset = static_cast<double>(2 * (k - start) - period) * (0.5 * tau);  // t_k - t_mid
-    s.v[i] = s.vh[i] + offset * s.a[i];
-    s.rho[i] = s.rhoh[i] + offset * s.drho[i];
+    if (predictor_ == TimePredictor::extrapolated) {
+      // The rates a + (t - t_n) jerk integrated from t_n: vh holds v_n + (t_mid - t_n) a, so this adds the jerk's
+      // (t_k - t_n)^2 / 2 (exact for rates linear in time).
+      const double since = static_cast<double>(k - start) * tau;  // t_k - t_n
+      const double half_square = 0.5 * since * since;
+      s.v[i] = s.vh[i] + offset * s.a[i] + half_square * s.jerk[i];
+      s.rho[i] = s.rhoh[i] + offset * s.drho[i] + half_square * s.density_jerk[i];
+    } else {
+      s.v[i] = s.vh[i] + offset * s.a[i];
+      s.rho[i] = s.rhoh[i] + offset * s.drho[i];
+    }
     s.p[i] = eos_.pressure(s.rho[i]);
   }
 
@@ -253,6 +270,7 @@ class Integrator {
   TimeStepping mode_;
   TaitEquationOfState eos_;
   int bin_jump_ = kDefaultBinJump;
+  TimePredictor predictor_ = TimePredictor::extrapolated;
 };
 
 }  // namespace sph

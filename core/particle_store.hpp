@@ -40,6 +40,8 @@ struct ParticleView {
   std::int32_t* next_bin = nullptr;
   double* stiffness = nullptr;
   double* dt_limit = nullptr;
+  Vec<D>* jerk = nullptr;
+  double* density_jerk = nullptr;
 };
 
 template <int D>
@@ -82,6 +84,11 @@ class ParticleStore {
   Field<std::int32_t> next_bin{"next_time_bin", "1"};
   Field<double> stiffness{"acoustic_stiffness", "1"};
   Field<double> dt_limit{"time_step_limit", "s"};
+  // The change of a and drho between the particle's last two evaluations over the time between them (core/sweep.hpp);
+  // the extrapolated predictor (Integrator::drift) integrates a + t jerk. Zero before a particle's second evaluation
+  // in a run and after a merge; a daughter keeps its parent's.
+  Field<VecD> jerk{"jerk", "m/s^3"};
+  Field<double> density_jerk{"density_jerk", "kg/m^3/s^2"};
 
   /// The registry: every field as a pointer to member. Adding a field above and here is all it takes for
   /// every operation (gather, compaction, expansion, copies, output, checkpoints) to carry it.
@@ -92,7 +99,7 @@ class ParticleStore {
                            &ParticleStore::vh, &ParticleStore::rhoh, &ParticleStore::level_time,
                            &ParticleStore::origin, &ParticleStore::kick, &ParticleStore::kick_rho,
                            &ParticleStore::bin, &ParticleStore::next_bin, &ParticleStore::stiffness,
-                           &ParticleStore::dt_limit);
+                           &ParticleStore::dt_limit, &ParticleStore::jerk, &ParticleStore::density_jerk);
   }
 
   /// Visits every field. f is called with each Field<T>&.
@@ -198,7 +205,8 @@ class ParticleStore {
   ParticleView<D> view() {
     return {size(), x.data(), v.data(), rho.data(), p.data(), m.data(), h.data(), d.data(),
             level.data(), kind.data(), id.data(), drho.data(), a.data(), vh.data(), rhoh.data(), level_time.data(),
-            origin.data(), kick.data(), kick_rho.data(), bin.data(), next_bin.data(), stiffness.data(), dt_limit.data()};
+            origin.data(), kick.data(), kick_rho.data(), bin.data(), next_bin.data(), stiffness.data(), dt_limit.data(),
+            jerk.data(), density_jerk.data()};
   }
 
   /// Bytes held by every field (data and scratch), for memory reports.
@@ -210,7 +218,7 @@ class ParticleStore {
 
   /// Bytes one particle occupies across all fields.
   static constexpr std::size_t bytes_per_particle() {
-    return 5 * sizeof(VecD) + 11 * sizeof(double) + 3 * sizeof(std::int32_t) + sizeof(Kind) + sizeof(ParticleId) +
+    return 6 * sizeof(VecD) + 12 * sizeof(double) + 3 * sizeof(std::int32_t) + sizeof(Kind) + sizeof(ParticleId) +
            sizeof(Origin);
   }
 

@@ -17,7 +17,8 @@ namespace sph {
 
 template <int D>
 SimulationT<D>::SimulationT(Settings settings)
-    : settings_(std::move(settings)), integrator_(settings_.stepping, settings_.eos, settings_.bin_jump) {
+    : settings_(std::move(settings)),
+      integrator_(settings_.stepping, settings_.eos, settings_.bin_jump, settings_.predictor) {
   if (settings_.ghosts) {
     ghosts_.emplace(settings_.geometry.walls(), *settings_.ghosts, settings_.ghost_pressure,
                     settings_.gravity.value_or(Vec<D>::Zero()), settings_.eos);
@@ -460,6 +461,7 @@ StepInfo SimulationT<D>::step(double dt_cap) {
       if (choose) rebin = choose_bins_on_grid();
       Activity act = activity(k, finest);
       act.rebin = rebin;
+      act.dt0 = dt;
       lim = sweep_->run(store_.view(), grid_, act);
     } catch (const std::exception& e) {
       if (!watch && !domain_) throw;

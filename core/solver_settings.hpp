@@ -57,6 +57,7 @@ struct SolverSettingsT {
   double dt_max = 1.0;  // upper bound on the step (s)
   TimeStepping stepping = TimeStepping::global;
   int bin_jump = kDefaultBinJump;  // per_level: neighbours' bins at most this far apart (Integrator::limit_bins)
+  TimePredictor predictor = TimePredictor::extrapolated;  // Integrator::drift
   WatchdogSettings watchdog;
 };
 

@@ -70,14 +70,47 @@ struct Activity {
   // a run [b, e) are due_index[due_prefix[b] .. due_prefix[e]). A particle that is not due then walks only those,
   // in the same order as the run's: the same pairs and sums, without the candidates that cannot pair with it.
   const std::uint32_t* due_index = nullptr;
+  // The coarse step dt0 of the step this evaluation belongs to: a due particle's last evaluation was dt0 2^-b ago, and
+  // the sweep sets its jerk from the two. 0 for an evaluation that does not end a step (Simulation::refresh, after a
+  // refinement pass or at set-up): the jerk is then left as it is.
+  double dt0 = 0.0;
   int bin(std::int32_t b) const { return b < bin_cap ? static_cast<int>(b) : bin_cap; }
+};
+
+/// The acoustic length L_i of a particle's time-step limit dt_cfl,i = L_i / (c0 + max_j |mu_ij|), before the
+/// Courant number: h_i, or shorter where the neighbourhood is stiff enough to take the particle's fastest acoustic
+/// mode beyond what the predictor keeps stable (docs/METHOD.md, "The predictor").
+struct AcousticLimit {
+  /// The fastest acoustic mode's frequency over (c0 / rho_i) sum_j m_j |grad W_ij| at the particles it lives on:
+  /// 0.53-0.61, measured on the three-level dam break's frames, 0.59 on the 2D lattice (docs/METHOD.md, "Time step and
+  /// three refinement levels"); the upper end, so that the bound holds for each.
+  static constexpr double kFastestModeShare = 0.61;
+  /// The largest z = omega dt allowed with the extrapolated predictor: it damps every mode up to z = 0.67 (the linear
+  /// analysis of one acoustic mode, tools/acoustic_amplification.py), and grows them beyond. Three quarters of that,
+  /// because the analysis holds the positions fixed and takes one mode at a time.
+  static constexpr double kMaxZ = 0.5;
+
+  TimePredictor predictor = TimePredictor::extrapolated;
+  double cfl = 0.2;  // the Courant number the limit is multiplied by (time.cfl)
+
+  /// last_rate: kappa(h / d) rho / grad_mass where shorter than h (LatticeGradientSum::acoustic_length), which keeps
+  /// every particle's fastest mode at its own lattice's z; the last-rate prediction grows every mode, and on the
+  /// lattice the artificial viscosity outweighs that. extrapolated: kMaxZ rho / (kFastestModeShare cfl grad_mass)
+  /// where shorter than h, so that omega dt <= kMaxZ (at C = 0.2 in 2D a neighbourhood about twice as stiff as the
+  /// lattice's).
+  template <int D>
+  double length(const LatticeGradientSum<D>& lattice, double h, double d, double rho, double grad_mass) const {
+    if (predictor == TimePredictor::last_rate) return lattice.acoustic_length(h, d, rho, grad_mass);
+    if (!(grad_mass > 0.0)) return h;
+    return std::min(h, kMaxZ * rho / (kFastestModeShare * cfl * grad_mass));
+  }
 };
 
 template <int D, class FluidEffects, class WallEffects>
 class PairSweep {
  public:
-  PairSweep(FluidEffects fluid, WallEffects wall, double c0, Vec<D> gravity)
-      : fluid_(std::move(fluid)), wall_(std::move(wall)), c0_(c0), gravity_(std::move(gravity)) {}
+  PairSweep(FluidEffects fluid, WallEffects wall, double c0, Vec<D> gravity, AcousticLimit acoustic = {})
+      : fluid_(std::move(fluid)), wall_(std::move(wall)), c0_(c0), gravity_(std::move(gravity)), acoustic_(acoustic) {}
 
 
   /// Computes kick and kick_rho of every fluid particle, and a and drho of the due ones (others get zero),
@@ -207,13 +240,22 @@ class PairSweep {
           } else {
             next = acc;
           }
-          s.a[i] = scale * next.a;
-          s.drho[i] = scale * next.drho;
+          {
+            const Vec<D> a_new = scale * next.a;
+            const double drho_new = scale * next.drho;
+            if (act.dt0 > 0.0) {  // the rates' change since i's last evaluation, dt0 2^-b_i ago (Integrator::drift)
+              const double since = act.dt0 * kBinWeight[static_cast<std::size_t>(bi)];
+              s.jerk[i] = (a_new - s.a[i]) / since;
+              s.density_jerk[i] = (drho_new - s.drho[i]) / since;
+            }
+            s.a[i] = a_new;
+            s.drho[i] = drho_new;
+          }
           const double an = s.a[i].norm();
           const double own_force = an > 0.0 ? std::sqrt(hi / an) : inf;
           // h_i / (c0 + max mu), with h_i shortened where the neighbours are stiffer than i's own lattice
           // (LatticeGradientSum::acoustic_length; docs/METHOD.md, "Time step and three refinement levels").
-          const double length = lattice_.acoustic_length(hi, s.d[i], s.rho[i], grad_mass);
+          const double length = acoustic_.length(lattice_, hi, s.d[i], s.rho[i], grad_mass);
           const double own_cfl = length / (c0_ + mu_max);
           s.stiffness[i] = hi / length;
           s.dt_limit[i] = std::min(own_force, own_cfl);
@@ -238,6 +280,7 @@ class PairSweep {
   WallEffects wall_;
   double c0_;
   Vec<D> gravity_;
+  AcousticLimit acoustic_;
 };
 
 }  // namespace sph

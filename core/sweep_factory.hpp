@@ -30,8 +30,8 @@ class SweepBase {
 template <int D, class Fluid, class Wall>
 class SweepImpl final : public SweepBase<D> {
  public:
-  SweepImpl(Fluid f, Wall w, double c0, Vec<D> g, std::string name)
-      : sweep_(std::move(f), std::move(w), c0, std::move(g)), name_(std::move(name)) {}
+  SweepImpl(Fluid f, Wall w, double c0, Vec<D> g, AcousticLimit acoustic, std::string name)
+      : sweep_(std::move(f), std::move(w), c0, std::move(g), acoustic), name_(std::move(name)) {}
   SweepLimits run(ParticleView<D> s, const CellGrid<D>& grid, Activity act = {}) const override {
     return sweep_(s, grid, act);
   }
@@ -50,9 +50,11 @@ std::unique_ptr<SweepBase<D>> with_walls(Fluid fluid, const SolverSettingsT<D>& 
   if (s.lennard_jones) {
     auto wall = std::make_tuple(LennardJonesWall{s.lennard_jones->strength, s.lennard_jones->r0_factor});
     return std::make_unique<SweepImpl<D, Fluid, decltype(wall)>>(std::move(fluid), std::move(wall), s.eos.c0, g,
+                                                             AcousticLimit{s.predictor, s.cfl},
                                                              name + "|lj");
   }
-  return std::make_unique<SweepImpl<D, Fluid, std::tuple<>>>(std::move(fluid), std::tuple<>{}, s.eos.c0, g, name);
+  return std::make_unique<SweepImpl<D, Fluid, std::tuple<>>>(std::move(fluid), std::tuple<>{}, s.eos.c0, g,
+                                                           AcousticLimit{s.predictor, s.cfl}, name);
 }
 
 template <int D, class Fluid>

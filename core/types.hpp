@@ -53,6 +53,13 @@ enum class Origin : std::uint8_t { setup = 0, split = 1, fresh_merge = 2, merge 
 
 /// time.stepping (core/integrator.hpp): one global step (the paper's), or power-of-two steps per refinement level.
 enum class TimeStepping { global, per_level };
+/// time.predictor (core/integrator.hpp, Integrator::drift): how v and rho are predicted for an evaluation inside or
+/// at the end of a particle's step. `extrapolated` integrates the rates extrapolated linearly from the particle's
+/// last two evaluations (a + t jerk); `last_rate` holds the last evaluation's rates (the scheme until 2026-12-02,
+/// the same to first order as DualSPHysics' symplectic one). The last-rate prediction grows the fastest acoustic
+/// modes by z^4/4 a step (z = omega dt), which the stiffness-aware acoustic limit contains; the extrapolated one
+/// damps them up to z = 0.67 (docs/METHOD.md, "The predictor").
+enum class TimePredictor { extrapolated, last_rate };
 /// time.bin_jump's default: the most a particle's time bin may differ from a neighbour's (Integrator::limit_bins).
 /// One, measured on the hardest per-level case (docs/METHOD.md, "Time steps per level"): the three-level dam break
 /// per level stops on a density error of 0.5 at the right wall at t = 3.74 s without the limiter and at 4.04 s

@@ -40,13 +40,79 @@ TEST(Integrator, TheActiveBinFollowsThePowerOfTwoClock) {
   EXPECT_EQ(global.activity(1, 0).active_bin, 0);
 }
 
+// The prediction for an evaluation at substep k: v_n + (t_k - t_n) a_n, and with the extrapolated predictor also
+// (t_k - t_n)^2 / 2 jerk: exact for an acceleration linear in time, which the last-rate prediction is not. A
+// particle in bin 1 of a step with four substeps (bin 2 the finest) over two of its steps, the second opened by the
+// combined kick (vh += dt0 kick, with the first step's closing rate equal to the second's opening one). Tolerance: a
+// few roundings of sums of terms of order |v| (1e-15 relative), 1e-13 of the speed scale.
+TEST(Integrator, ThePredictionIsExactForRatesLinearInTime) {
+  const double dt0 = 0.1, tau = dt0 / 4.0;
+  const Vec<2> v0(1.0, -2.0), a0(3.0, 0.5), jerk(-4.0, 7.0);
+  const double rho0 = 1000.0, drho0 = 20.0, density_jerk = -300.0;
+  for (const TimePredictor predictor : {TimePredictor::extrapolated, TimePredictor::last_rate}) {
+    SCOPED_TRACE(predictor == TimePredictor::extrapolated ? "extrapolated" : "last_rate");
+    const Integrator integ(TimeStepping::per_level, TaitEquationOfState{}, kDefaultBinJump, predictor);
+    const double e = predictor == TimePredictor::extrapolated ? 1.0 : 0.0;
+    ParticleStore<2> store;
+    store.resize(1);
+    store.kind[0] = Kind::fluid;
+    store.bin[0] = store.next_bin[0] = 1;
+    store.v[0] = v0;
+    store.rho[0] = rho0;
+    store.a[0] = a0;
+    store.drho[0] = drho0;
+    store.jerk[0] = jerk;
+    store.density_jerk[0] = density_jerk;
+    const auto s = store.view();
+    integ.open(s, 0, dt0);
+    const double step = 0.5 * dt0;  // bin 1
+    for (int k = 1; k <= 4; ++k) {
+      if (k == 3) {  // the second step opens: the rates at t = step, as the exact motion has them
+        const Vec<2> a1 = a0 + step * jerk;
+        const double drho1 = drho0 + step * density_jerk;
+        // The driver's combined kick, vh += dt0 kick with kick = 2^-1 a1: the closing half-kick (vh = v_n + step/2 a_n
+        // closes to the trapezoid of a_n and a1, exact for a linear rate) and the opening one with a1.
+        s.vh[0] += step * a1;
+        s.rhoh[0] += step * drho1;
+        s.a[0] = a1;
+        s.drho[0] = drho1;
+      }
+      integ.drift(s, 0, tau, k, 2);
+      const double t = k * tau;                 // since the first step's start
+      const double since = k <= 2 ? t : t - step;  // since the particle's current step began
+      const Vec<2> v_start = k <= 2 ? v0 : Vec<2>(v0 + step * a0 + 0.5 * step * step * jerk);
+      const Vec<2> a_start = k <= 2 ? a0 : Vec<2>(a0 + step * jerk);
+      // The last-rate prediction, and the extrapolated one on top of it.
+      const Vec<2> expected = v_start + since * a_start + e * (0.5 * since * since) * jerk;
+      EXPECT_LE((s.v[0] - expected).norm(), 1e-13 * v0.norm()) << "substep " << k;
+      if (predictor == TimePredictor::extrapolated) {
+        const Vec<2> exact = v0 + t * a0 + 0.5 * t * t * jerk;
+        EXPECT_LE((s.v[0] - exact).norm(), 1e-13 * v0.norm()) << "substep " << k << ": the exact motion";
+      }
+    }
+    // The density at the last substep (the same algebra, one rate; its second step's rhoh from the trapezoid).
+    const double t = 4 * tau;
+    const double drho1 = drho0 + step * density_jerk;
+    const double rho_start = rho0 + 0.5 * step * (drho0 + drho1);
+    EXPECT_NEAR(s.rho[0], rho_start + step * drho1 + e * 0.5 * step * step * density_jerk, 1e-13 * rho0);
+    if (predictor == TimePredictor::extrapolated) {
+      EXPECT_NEAR(s.rho[0], rho0 + t * drho0 + 0.5 * t * t * density_jerk, 1e-13 * rho0);
+    }
+  }
+}
+
 /// A rotating, drifting, perturbed circular cloud (as the single-rate conservation test), with a band refined to
 /// level 1 and a smaller patch inside it to level 2, so that pairs of every level combination interact.
-Simulation three_level_cloud(TimeStepping stepping, int bin_jump = kDefaultBinJump) {
+/// With the last-rate predictor the AAP daughters at the level jumps, whose coarse neighbours are heavier, sum a
+/// stiffer neighbourhood than their lattice's and step a bin finer than their level, so bins change from step to
+/// step; with the extrapolated one (the default) their stiffness stays within what it keeps stable (AcousticLimit).
+Simulation three_level_cloud(TimeStepping stepping, int bin_jump = kDefaultBinJump,
+                             TimePredictor predictor = TimePredictor::extrapolated) {
   SolverSettings st = test::isolated_settings(20.0, true);
   st.geometry.container = {Vec<2>(-100, -100), Vec<2>(100, 100)};  // no walls: only the watchdog sees it
   st.stepping = stepping;
   st.bin_jump = bin_jump;
+  st.predictor = predictor;
   Simulation sim(st);
   FluidBlockSpec spec;
   spec.spacing = 0.1;
@@ -104,8 +170,12 @@ std::size_t count_level(const ParticleStore<2>& s, int level) {
 // The target: over 1000 coarse steps with three levels, linear momentum to 1e-12 of sum m|v| and angular
 // momentum to 1e-10 of sum m|x||v| (the single-rate test's bounds: every impulse is a pair's, equal and opposite
 // and along x_ij, so both are exact up to the rounding of the sums, which grows with the number of steps).
+// Both predictors: the kicks, which alone change the momenta, are the same; with the last-rate one the bins change
+// from step to step (three_level_cloud), so the checks cover the steps that rebin.
 TEST(Integrator, ThreeLevelCloudPerLevelConservesMomentumAndAngularMomentumOver1000CoarseSteps) {
-  Simulation sim = three_level_cloud(TimeStepping::per_level);
+  for (const TimePredictor predictor : {TimePredictor::extrapolated, TimePredictor::last_rate}) {
+  SCOPED_TRACE(predictor == TimePredictor::extrapolated ? "extrapolated" : "last_rate");
+  Simulation sim = three_level_cloud(TimeStepping::per_level, kDefaultBinJump, predictor);
   auto& s = sim.store();
   ASSERT_GT(count_level(s, 0), 100u);
   ASSERT_GT(count_level(s, 1), 100u);
@@ -117,21 +187,23 @@ TEST(Integrator, ThreeLevelCloudPerLevelConservesMomentumAndAngularMomentumOver1
   const std::uint64_t steps = test::short_runs() ? 200 : 1000;
   int substeps = 0;
   for (std::uint64_t k = 0; k < steps; ++k) substeps = std::max(substeps, sim.step().substeps);
-  // Level l steps in bin l or finer: finer where a particle's own limit asks (Integrator::bin_for; the AAP
-  // daughters at the level jumps, whose coarse neighbours are heavier, sum a stiffer neighbourhood than their
-  // lattice's), so bins change from step to step and the momentum checks below cover the steps that rebin.
+  // Level l steps in bin l or finer: finer where a particle's own limit asks (Integrator::bin_for).
   EXPECT_GE(substeps, 4) << "three levels step in at least four substeps";
   EXPECT_GE(sim.work().evaluations[0], steps * n0);
   EXPECT_GE(sim.work().evaluations[1], 2 * steps * n1);
   EXPECT_GE(sim.work().evaluations[2], 4 * steps * n2);
-  // The bins change from step to step (so the checks below cover the steps that rebin): some particles of some
-  // level take more evaluations than their level's bin gives them. Which level depends on the bin choice's cost
-  // model (Simulation::choose_bins: a finer bin for a few stiff level-2 daughters doubles every particle's
-  // substeps, so the coarse step may shrink instead and put coarser particles one bin finer).
-  EXPECT_GT(sim.work().evaluations[0] + sim.work().evaluations[1] + sim.work().evaluations[2],
-            steps * (n0 + 2 * n1 + 4 * n2))
-      << "some particles step finer than their level: " << sim.work().evaluations[0] << " " << sim.work().evaluations[1]
-      << " " << sim.work().evaluations[2] << " against " << steps * n0 << " " << 2 * steps * n1 << " " << 4 * steps * n2;
+  // With the last-rate predictor the bins change from step to step (so the checks below cover the steps that
+  // rebin): some particles of some level take more evaluations than their level's bin gives them. Which level
+  // depends on the bin choice's cost model (Simulation::choose_bins: a finer bin for a few stiff level-2 daughters
+  // doubles every particle's substeps, so the coarse step may shrink instead and put coarser particles one bin
+  // finer).
+  if (predictor == TimePredictor::last_rate) {
+    EXPECT_GT(sim.work().evaluations[0] + sim.work().evaluations[1] + sim.work().evaluations[2],
+              steps * (n0 + 2 * n1 + 4 * n2))
+        << "some particles step finer than their level: " << sim.work().evaluations[0] << " "
+        << sim.work().evaluations[1] << " " << sim.work().evaluations[2] << " against " << steps * n0 << " "
+        << 2 * steps * n1 << " " << 4 * steps * n2;
+  }
   EXPECT_GE(sim.work().substeps, 4 * steps);
   EXPECT_EQ(sim.fine_step_count(), sim.work().substeps);
   sim.remove_ghosts();
@@ -140,6 +212,7 @@ TEST(Integrator, ThreeLevelCloudPerLevelConservesMomentumAndAngularMomentumOver1
   EXPECT_LE((m1.P - m0.P).norm(), 1e-12 * sc.linear);
   EXPECT_LE(std::abs(m1.L - m0.L), 1e-10 * sc.angular);
   EXPECT_TRUE(test::all_finite(sim.store()));
+  }
 }
 
 // Per-level stepping takes fewer, longer coarse steps than the global step over the same time. The cloud's step
@@ -285,8 +358,9 @@ TEST(Integrator, NeighbourhoodBinsEqualBruteForce) {
   }
 }
 
-// With bin_jump = 1 (the default), over 200 coarse steps of the three-level cloud: after every step no two
-// neighbours' bins differ by more than one; the limiter acted (the run takes more evaluations than with bin_jump = 2,
+// With bin_jump = 1 (the default), over 200 coarse steps of the three-level cloud with the last-rate predictor
+// (whose stiff daughters step a bin finer than their level, three_level_cloud, which gives the limiter work): after
+// every step no two neighbours' bins differ by more than one; the limiter acted (the run takes more evaluations than with bin_jump = 2,
 // where the daughters at the level jumps that step a bin finer than their level sit two bins from their coarse
 // neighbours); linear and angular momentum stay exact (the bounds of the conservation test above: raised bins
 // change from step to step, so steps rebin); and the run is the same at 1 and 2 threads.
@@ -296,14 +370,14 @@ TEST(Integrator, BinJumpOneKeepsNeighboursWithinOneBinAndMomentumExact) {
   std::uint64_t jump2_evaluations = 0;
   {
     omp_set_num_threads(1);
-    Simulation sim = three_level_cloud(TimeStepping::per_level, 2);
+    Simulation sim = three_level_cloud(TimeStepping::per_level, 2, TimePredictor::last_rate);
     for (std::uint64_t k = 0; k < steps; ++k) sim.step();
     for (const std::uint64_t e : sim.work().evaluations) jump2_evaluations += e;
   }
   ParticleStore<2> result[2];
   for (int t = 1; t <= 2; ++t) {
     omp_set_num_threads(t);
-    Simulation sim = three_level_cloud(TimeStepping::per_level, 1);
+    Simulation sim = three_level_cloud(TimeStepping::per_level, 1, TimePredictor::last_rate);
     const Totals m0 = totals(sim.store());
     const test::MomentumScales sc = test::momentum_scales(sim.store());
     std::size_t violations = 0;

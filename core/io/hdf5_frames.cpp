@@ -16,7 +16,9 @@ namespace {
 
 constexpr hid_t kDefault = 0;  // H5P_DEFAULT
 constexpr const char* kCheckpointGroup = "checkpoint";
-constexpr std::uint64_t kCheckpointFormat = 1;
+// The layout of a checkpoint: its fields are the store's registry. 2 since the store holds the jerk fields
+// (time.predictor, 2026-12-02): a checkpoint of format 1 lacks them and is refused by name, not half read.
+constexpr std::uint64_t kCheckpointFormat = 2;
 
 /// Silences HDF5's own error printing once: failures become exceptions with a message of ours.
 void quiet_hdf5() {

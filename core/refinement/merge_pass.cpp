@@ -186,6 +186,8 @@ MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::
     s.drho[k] = 0.0;
     s.kick[k].setZero();
     s.kick_rho[k] = 0.0;
+    s.jerk[k].setZero();  // no history of its own: its first step predicts from its first rates alone
+    s.density_jerk[k] = 0.0;
     // Its limits are not known until then: its bin is its level's (Integrator::bin_for).
     s.stiffness[k] = 1.0;
     s.dt_limit[k] = 0.0;

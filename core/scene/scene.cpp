@@ -200,6 +200,7 @@ const char* to_string(MergeGroups v) { return choice_name(v); }
 const char* to_string(ProbeKind v) { return choice_name(v); }
 const char* to_string(GhostPressure v) { return choice_name(v); }
 const char* to_string(TimeStepping v) { return choice_name(v); }
+const char* to_string(TimePredictor v) { return choice_name(v); }
 
 std::vector<std::string> particle_field_names() {
   std::vector<std::string> names;

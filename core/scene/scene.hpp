@@ -117,6 +117,7 @@ struct Time {
   double dt_max = 1.0;
   TimeStepping stepping = TimeStepping::global;  // "global" or "per_level" (core/integrator.hpp)
   int bin_jump = kDefaultBinJump;                // per_level: the bin limiter (Integrator::limit_bins)
+  TimePredictor predictor = TimePredictor::extrapolated;  // Integrator::drift
   bool operator==(const Time&) const = default;
 
   double interval() const { return output_interval.value_or(end / 100.0); }
@@ -221,5 +222,6 @@ const char* to_string(ProbeKind v);
 const char* to_string(Outflow v);
 const char* to_string(GhostPressure v);
 const char* to_string(TimeStepping v);
+const char* to_string(TimePredictor v);
 
 }  // namespace sph::scene

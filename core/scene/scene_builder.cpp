@@ -36,6 +36,7 @@ SolverSettingsT<D> solver_settings(const Scene& scene) {
   s.dt_max = scene.time.dt_max;
   s.stepping = scene.time.stepping;
   s.bin_jump = scene.time.bin_jump;
+  s.predictor = scene.time.predictor;
   return s;
 }
 

@@ -58,6 +58,11 @@ struct Choices<TimeStepping> {
       {{"global", TimeStepping::global}, {"per_level", TimeStepping::per_level}}};
 };
 template <>
+struct Choices<TimePredictor> {
+  static constexpr std::array<Choice<TimePredictor>, 2> table{
+      {{"extrapolated", TimePredictor::extrapolated}, {"last_rate", TimePredictor::last_rate}}};
+};
+template <>
 struct Choices<ProbeKind> {
   static constexpr std::array<Choice<ProbeKind>, 4> table{{{"water_height", ProbeKind::water_height},
                                                            {"surge_front", ProbeKind::surge_front},

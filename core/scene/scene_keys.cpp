@@ -150,6 +150,10 @@ const S<Time>& time_section() {
               .note("`per_level` only")
               .means("the most a particle's time bin may differ from a neighbour's: a particle steps at least "
                      "`2^-bin_jump` as often as its most frequent neighbour (a limiter, docs/METHOD.md)"));
+    d.add(value<Time>("predictor", member(&Time::predictor))
+              .means("how `v` and `rho` are predicted for an evaluation: `extrapolated` from the last two "
+                     "evaluations' rates, `last_rate` from the last one's, with the step shortened where the "
+                     "neighbours are stiffer than the particle's lattice (docs/METHOD.md, \"The predictor\")"));
     return d;
   }();
   return s;

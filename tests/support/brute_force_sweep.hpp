@@ -135,8 +135,12 @@ ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<
     ref.a[i] = up * next_ai;
     ref.drho[i] = up * next_drho;
     if (ref.a[i].norm() > 0.0) ref.dt_force = std::min(ref.dt_force, up * std::sqrt(s.h[i] / ref.a[i].norm()));
-    // The acoustic length: h_i, or kappa(h_i / d_i) rho_i / sum_j m_j |grad W_ij| where shorter (kernel.hpp).
-    const double length = grad_mass > 0.0 ? std::min(s.h[i], lattice(s.h[i] / s.d[i]) * s.rho[i] / grad_mass) : s.h[i];
+    // The acoustic length (core/sweep.hpp, AcousticLimit): h_i, or where shorter, with the last-rate predictor
+    // kappa(h_i / d_i) rho_i / sum_j m_j |grad W_ij| (kernel.hpp), with the extrapolated one the length at which
+    // C L / c0 puts 0.61 (c0 / rho_i) sum_j m_j |grad W_ij| (the fastest mode's frequency) at omega dt = 0.5.
+    const double stiff = st.predictor == sph::TimePredictor::last_rate ? lattice(s.h[i] / s.d[i]) * s.rho[i] / grad_mass
+                                                                       : 0.5 * s.rho[i] / (0.61 * st.cfl * grad_mass);
+    const double length = grad_mass > 0.0 ? std::min(s.h[i], stiff) : s.h[i];
     ref.dt_cfl = std::min(ref.dt_cfl, up * length / (c + mu_max));
   }
   return ref;
