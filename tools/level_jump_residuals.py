@@ -2,14 +2,22 @@
 """The static force imbalance of a hydrostatic lattice across a 2:1 level jump, for several pressure-term
 forms (docs/METHOD.md, "Still water across a level jump").
 
-    /usr/bin/python3 tools/level_jump_residuals.py
+    /usr/bin/python3 tools/level_jump_residuals.py [--interface]
 
 A 40 x 30 lattice (spacing d = 1 m, h = 1.2 d, rho = 1, p/rho = g (30 - y)) whose block [15,25] x [10,20] is
 split by AAP (daughters at +-d/4, h/2 unless a ratio is given). For each form it prints the largest
 |a_i - g| over the particles at least 4 m from the lattice's edges, coarse and fine apart (m/s^2). The
 kernel is the cubic spline of core/kernel.hpp, written again here in numpy because this evaluates the sums
 outside the solver (every pair against every other, no cell grid).
+
+--interface prints instead the kernel sums sigma_i = sum_j m_j W(r_ij, h_ij) (rho = 1) along a row across the
+jump, and the jump's excess: sum_i m_i (sigma_i - sigma of i's level's bulk) over the particles near the block,
+per metre of the block's perimeter, coarse and fine apart, for several rules for h_ij. Under a pressure p the
+elastic energy changes by p / rho^2 times the change of sum_i m_i rho_i, so a negative excess means a jump that
+releases energy as it grows (docs/METHOD.md, "the level jump's interface energy").
 """
+import sys
+
 import numpy as np
 
 SIGMA = 10.0 / (7.0 * np.pi)
@@ -79,7 +87,48 @@ def residuals(form, ratio=0.5, slope=None, zone=ZONE):
     return res[lev == 0].max(), (res[lev == 1].max() if (lev == 1).any() else float("nan"))
 
 
+def kernel(r, h):
+    q = r / h
+    c = SIGMA / h ** 2
+    return np.where(q < 1, c * (1 - 1.5 * q * q + 0.75 * q ** 3), np.where(q < 2, c * 0.25 * (2 - q) ** 3, 0.0))
+
+
+PAIR_H = {"mean (the paper's)": lambda hi, hj: 0.5 * (hi + hj),
+          "quadratic mean": lambda hi, hj: np.sqrt(0.5 * (hi * hi + hj * hj)),
+          "max": np.maximum}
+
+
+def kernel_sums(rule, zone=ZONE):
+    X, H, M, L = lattice(zone)
+    if rule == "averaged kernel":
+        sig = np.array([(M * 0.5 * (kernel(np.hypot(*(X - X[i]).T), H[i]) + kernel(np.hypot(*(X - X[i]).T), H))).sum()
+                        for i in range(len(X))])
+    else:
+        sig = np.array([(M * kernel(np.hypot(*(X - X[i]).T), PAIR_H[rule](H[i], H))).sum() for i in range(len(X))])
+    return X, M, L, sig
+
+
+def interface():
+    x0, y0, x1, y1 = ZONE
+    perimeter = 2.0 * ((x1 - x0) + (y1 - y0))
+    print("| h_ij | sigma: coarse at the jump, first and second fine column | excess per m: coarse, fine, total |")
+    print("|---|---|---|")
+    for rule in list(PAIR_H) + ["averaged kernel"]:
+        X, M, L, sig = kernel_sums(rule)
+        inner = (X[:, 0] > 5) & (X[:, 0] < 35) & (X[:, 1] > 4) & (X[:, 1] < 26)
+        coarse_bulk = sig[(L == 0) & inner & ((X[:, 0] < 10) | (X[:, 0] > 30))].mean()
+        fine_bulk = sig[(L == 1) & (np.abs(X[:, 0] - 20) < 1.5) & (np.abs(X[:, 1] - 15) < 1.5)].mean()
+        excess = np.where(L == 0, sig - coarse_bulk, sig - fine_bulk) * M
+        c, f = excess[inner & (L == 0)].sum() / perimeter, excess[inner & (L == 1)].sum() / perimeter
+        row = np.abs(X[:, 1] - 14.6) < 0.2  # the row y = 14.5 (coarse) and 14.75 (fine)
+        at = lambda x: sig[row & (np.abs(X[:, 0] - x) < 0.01)][0]  # noqa: E731
+        print(f"| {rule} | {at(14.5):.3f}, {at(15.25):.3f}, {at(15.75):.3f} | {c:+.4f}, {f:+.4f}, {c + f:+.4f} |")
+
+
 def main():
+    if "--interface" in sys.argv[1:]:
+        interface()
+        return
     rows = [("uniform lattice, no jump", dict(form="symmetric", zone=(-9, -9, -8, -8))),
             ("paper: h_ij mean, daughters h/2", dict(form="symmetric"))]
     rows += [(f"daughters' h ratio {q}", dict(form="symmetric", ratio=q)) for q in (0.6, 0.7, 0.8)]
