@@ -59,7 +59,6 @@ class Integrator {
       : mode_(mode), eos_(eos), bin_jump_(bin_jump), predictor_(predictor) {}
 
   TimeStepping mode() const { return mode_; }
-  TimePredictor predictor() const { return predictor_; }
   int bin_cap() const { return mode_ == TimeStepping::global ? 0 : kMaxBin; }
   int bin(std::int32_t b) const { return Activity{0, bin_cap()}.bin(b); }
   int bin_jump() const { return bin_jump_; }

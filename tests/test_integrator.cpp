@@ -360,8 +360,8 @@ TEST(Integrator, NeighbourhoodBinsEqualBruteForce) {
 
 // With bin_jump = 1 (the default), over 200 coarse steps of the three-level cloud with the last-rate predictor
 // (whose stiff daughters step a bin finer than their level, three_level_cloud, which gives the limiter work): after
-// every step no two neighbours' bins differ by more than one; the limiter acted (the run takes more evaluations than with bin_jump = 2,
-// where the daughters at the level jumps that step a bin finer than their level sit two bins from their coarse
+// every step no two neighbours' bins differ by more than one; the limiter acted (the run takes more evaluations
+// than with bin_jump = 2, where the daughters at the level jumps that step a bin finer than their level sit two bins from their coarse
 // neighbours); linear and angular momentum stay exact (the bounds of the conservation test above: raised bins
 // change from step to step, so steps rebin); and the run is the same at 1 and 2 threads.
 TEST(Integrator, BinJumpOneKeepsNeighboursWithinOneBinAndMomentumExact) {

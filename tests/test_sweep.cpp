@@ -156,6 +156,21 @@ TEST(Sweep, EqualsBruteForceWithViscosity) {
   EXPECT_GT(changed_accelerations(brute_force(s, st), brute_force(s, twin_settings(false, false))), 100u);
 }
 
+// The extrapolated predictor's acoustic length (AcousticLimit) against the twin where it binds. Its bound,
+// 0.5 rho / (0.61 C sum m |grad W|), is shorter than h for a neighbourhood more than 0.5 / (0.61 C kappa) times as
+// stiff as the lattice: 2.09 at C = 0.2, which the twin cloud may never reach, 0.42 at C = 1, which every particle
+// passes. The comparison is sharp: the limit at C = 1 is shorter than at C = 0.2 (both before the Courant number).
+TEST(Sweep, ExtrapolatedAcousticLimitEqualsBruteForceWhereItBinds) {
+  SolverSettings st = twin_settings(true, false);
+  ASSERT_EQ(st.predictor, sph::TimePredictor::extrapolated);
+  st.cfl = 1.0;
+  ParticleStore<2> s = twin_cloud(st, 9u);
+  expect_matches_brute_force(s, st, "extrapolated acoustic limit, C = 1");
+  SolverSettings lattice_c = st;
+  lattice_c.cfl = 0.2;
+  EXPECT_LT(brute_force(s, st).dt_cfl, brute_force(s, lattice_c).dt_cfl);
+}
+
 TEST(Sweep, EqualsBruteForceWithLennardJonesWalls) {
   for (bool viscosity : {false, true}) {
     const SolverSettings st = twin_settings(viscosity, true);
