@@ -54,6 +54,13 @@ void SimulationT<D>::prepare_neighbours() {
   if (domain_) {
     for (const SmoothingRange& other : domain_->comm().all_gather_value(hr)) hr = hr.merged(other);
   }
+  // The counts above used the ghosts' reach of the last build. The fluid's largest h changes only where its
+  // particles change (a split or merge pass, the outflow, a restore: each ends here), so a step's own builds
+  // keep it. Where it did change, the counts are taken again with the new reach.
+  if (ghosts_ && hr.max() != ghosts_->largest_h() && !hr.empty()) {
+    ghosts_->set_largest_h(hr.max());
+    par::parallel_for(view.n, [&](std::size_t i) { expand_offsets_[i] = output_count(view, i); });
+  }
   build_neighbours(hr);
 }
 

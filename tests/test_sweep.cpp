@@ -13,6 +13,7 @@
 #include <random>
 #include <vector>
 
+#include "core/boundary/ghosts.hpp"
 #include "core/integrator.hpp"
 #include "core/kernel.hpp"
 #include "core/scene/scene_builder.hpp"
@@ -335,6 +336,33 @@ TEST(Sweep, EqualsBruteForceWithDensityDiffusion) {
   }
 }
 
+/// The store's particles without its ghosts, in its order, then the images `gb` gives each fluid particle, each
+/// made a ghost as the solver makes them: the brute force's own set of ghosts for the solver's rates.
+ParticleStore<2> with_images(const ParticleStore<2>& s, const sph::GhostBuilder& gb) {
+  std::vector<std::uint32_t> src;
+  std::vector<int> image;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] == Kind::ghost) continue;
+    src.push_back(static_cast<std::uint32_t>(i));
+    image.push_back(-1);
+  }
+  const std::size_t sources = src.size();
+  for (std::size_t k = 0; k < sources; ++k) {
+    const std::size_t i = src[k];
+    if (s.kind[i] != Kind::fluid) continue;
+    const int count = gb.images(s.x[i], s.v[i], s.h[i]).count;
+    for (int g = 0; g < count; ++g) {
+      src.push_back(static_cast<std::uint32_t>(i));
+      image.push_back(g);
+    }
+  }
+  ParticleStore<2> out = s;
+  out.gather(src);
+  auto view = out.view();
+  for (std::size_t k = sources; k < src.size(); ++k) gb.make_ghost(view, k, image[k]);
+  return out;
+}
+
 // The twin on the solver's own path: the store, ghosts, grid and rates exactly as Simulation::refresh() leaves
 // them (the cell size and query reach that prepare_neighbours computes, the driver's ghost expansion), in a
 // dam break with Lennard-Jones wall particles, free-slip ghost walls and a statically refined quarter (level-1
@@ -386,6 +414,55 @@ TEST(Sweep, SolverPathEqualsBruteForceInARefinedDamBreakWithWallsAndGhosts) {
     inviscid.viscosity.reset();
     EXPECT_GT(changed_accelerations(brute_force(s, st), brute_force(s, inviscid)), 100u);
   }
+}
+
+// The solver's ghosts are every image a pair reaches. A coarse particle by a wall interacts with a fine one within
+// h_c + h_f, and so with the fine particle's image while the two distances to the wall add up to less than that:
+// the fine particle needs an image up to h_f + h_c from the wall, beyond its own support 2 h_f. On the set-up's
+// lattice no such pair occurs (a coarse particle's nearest fine neighbour across the jump sits 1.5 d_f aside), so
+// the dam break's refined corner is jittered by a quarter of each particle's spacing. Against a brute force that
+// mirrors every fluid particle across every wall, whatever its distance (the kernel's support is then the only
+// cut), the solver's rates and pair count are the same.
+TEST(Sweep, SolverGhostsAreEveryImageThatACoarseParticleByAWallReaches) {
+  const std::filesystem::path cases = std::filesystem::path(__FILE__).parent_path().parent_path() / "cases";
+  sph::scene::Json doc = sph::scene::read_json_file(cases / "dam_break.json");
+  doc["effects"]["static_refinement"] = sph::scene::Json{{"box", {{"lo", {0, 0}}, {"hi", {12.5, 12.5}}}}};
+  sph::Simulation sim = sph::scene::build_simulation(sph::scene::scene_from_json(doc));
+  sim.remove_ghosts();
+  ParticleStore<2>& js = sim.store();
+  std::mt19937 rng(7u);
+  std::uniform_real_distribution<double> u(-0.25, 0.25);
+  const SolverSettings& st = sim.settings();
+  for (std::size_t i = 0; i < js.size(); ++i) {
+    if (js.kind[i] != Kind::fluid) continue;
+    const Vec<2> moved = js.x[i] + js.d[i] * Vec<2>(u(rng), u(rng));
+    if (st.geometry.in_fluid_domain(moved)) js.x[i] = moved;
+  }
+  sim.refresh();
+  const ParticleStore<2>& s = sim.store();
+  ASSERT_TRUE(st.ghosts.has_value());
+  // The solver's ghosts (as Simulation builds them) with a reach of each particle's images of h_i + largest_h.
+  const auto builder = [&](double largest_h) {
+    sph::GhostBuilder gb(st.geometry.walls(), *st.ghosts, st.ghost_pressure, st.gravity.value_or(Vec<2>::Zero()),
+                         st.eos);
+    gb.set_largest_h(largest_h);
+    return gb;
+  };
+  const ParticleStore<2> full = with_images(s, builder(1e3));  // every wall the particle projects onto
+  expect_rates_match_brute_force(full, sim.last_limits(), st, "every image");
+  // Sharp: with images of each particle within 2 h_i only, as the ghosts were until 2026-12-03, a pair goes missing
+  // and a coarse particle by the floor moves by far more than the twin's tolerance (1e-12 of its terms' sum).
+  const auto with_all = brute_force(full, st);
+  const auto near_only = brute_force(with_images(s, builder(0.0)), st);  // the same sources first, fewer ghosts
+  EXPECT_GT(with_all.pairs, near_only.pairs);
+  std::size_t moved = 0;
+  for (std::size_t i = 0; i < full.size(); ++i) {
+    if (full.kind[i] != Kind::fluid) continue;
+    if ((with_all.a[i] - near_only.a[i]).norm() <= 1e-10 * with_all.a_scale[i]) continue;
+    ++moved;
+    EXPECT_EQ(full.level[i], 0) << "only a coarse particle reaches beyond a fine one's 2 h_f";
+  }
+  EXPECT_GT(moved, 0u);
 }
 
 TEST(Sweep, ArtificialStressActsOnlyUnderTension) {

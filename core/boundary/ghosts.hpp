@@ -1,6 +1,7 @@
 #pragma once
 // Ghost particles (section 2.4): a fluid particle is mirrored across every wall face in reach (on the
-// fluid side, closer than 2 h_i, projecting onto the face), and through the corner of every two (in 3D also
+// fluid side, closer than h_i + h_max, projecting onto the face; h_max the largest fluid smoothing length, so
+// that a coarse particle by the wall finds the images of every fine neighbour its support h_i + h_j reaches), and through the corner of every two (in 3D also
 // three) of those walls that are mutually perpendicular and meet (a container's corner or edge, an obstacle's
 // foot on the floor or against a wall): the doubly (triply) reflected ghost. Perpendicular walls that do not meet (the floor and the face of an
 // obstacle that stands clear of it) give no corner ghost. Beyond kMaxWalls walls in reach only the nearest
@@ -9,6 +10,7 @@
 // from scratch each step (Simulation::prepare_neighbours): one stream expansion through the store's registry,
 // output_count() outputs per particle (old ghosts dropped), composed with the cell sort into one gather, then
 // make_ghost() on each copy that is an image; the result is deterministic at any thread count.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -49,6 +51,15 @@ class GhostBuilderT {
   const std::vector<Wall<D>>& walls() const { return walls_; }
   GhostSlip slip() const { return slip_; }
 
+  /// The largest smoothing length of the fluid (over every rank), which the reach of each particle's images adds
+  /// to its own: a pair interacts within h_i + h_j, and the image of j lies at least as far from i as j's own
+  /// distance to the wall, so j needs an image while that distance is below h_j + max_i h_i. With one level
+  /// (or before it is set, 0) the reach is 2 h. The driver sets it whenever the fluid's range changes
+  /// (Simulation::prepare_neighbours), before the output counts.
+  void set_largest_h(double h) { largest_h_ = h; }
+  double largest_h() const { return largest_h_; }
+  double reach(double h) const { return h + std::max(h, largest_h_); }
+
   /// The ghost images of a particle at x with smoothing length h: positions and velocities. First one per
   /// wall in reach, in the order of the wall list; then one per pair of those walls (in the same order) that
   /// are perpendicular and meet, reflected through both; in 3D then one per such triple.
@@ -65,11 +76,11 @@ class GhostBuilderT {
     };
     std::array<Near, kMaxWalls> near{};
     std::size_t nnear = 0;
-    const double reach = 2.0 * h;
+    const double within = reach(h);
     for (std::size_t w = 0; w < walls_.size(); ++w) {
       const Wall<D>& wall = walls_[w];
       const double dist = wall.signed_distance(x);
-      if (dist < 0.0 || dist >= reach || !wall.projects_onto(x)) continue;
+      if (dist < 0.0 || dist >= within || !wall.projects_onto(x)) continue;
       if (nnear < near.size()) {
         near[nnear++] = {w, dist};
         continue;
@@ -183,6 +194,7 @@ class GhostBuilderT {
   GhostPressure pressure_;
   Vec<D> gravity_;
   TaitEquationOfState eos_;
+  double largest_h_ = 0.0;
 };
 
 using GhostBuilder = GhostBuilderT<2>;
