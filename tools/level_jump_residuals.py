@@ -2,7 +2,7 @@
 """The static force imbalance of a hydrostatic lattice across a 2:1 level jump, for several pressure-term
 forms (docs/METHOD.md, "Still water across a level jump").
 
-    /usr/bin/python3 tools/level_jump_residuals.py [--interface]
+    /usr/bin/python3 tools/level_jump_residuals.py [--interface | --balance]
 
 A 40 x 30 lattice (spacing d = 1 m, h = 1.2 d, rho = 1, p/rho = g (30 - y)) whose block [15,25] x [10,20] is
 split by AAP (daughters at +-d/4, h/2 unless a ratio is given). For each form it prints the largest
@@ -15,6 +15,10 @@ jump, and the jump's excess: sum_i m_i (sigma_i - sigma of i's level's bulk) ove
 per metre of the block's perimeter, coarse and fine apart, for several rules for h_ij. Under a pressure p the
 elastic energy changes by p / rho^2 times the change of sum_i m_i rho_i, so a negative excess means a jump that
 releases energy as it grows (docs/METHOD.md, "the level jump's interface energy").
+
+--balance prints, for the mean and the quadratic-mean h_ij, the largest residual of the symmetric form before and
+after the least-squares pressure change of the particles within 1, 2 and 3 m of the block's edge that minimises it,
+and that change's size (docs/METHOD.md, "No pressures balance the split").
 """
 import sys
 
@@ -125,9 +129,56 @@ def interface():
         print(f"| {rule} | {at(14.5):.3f}, {at(15.25):.3f}, {at(15.75):.3f} | {c:+.4f}, {f:+.4f}, {c + f:+.4f} |")
 
 
+def balance_rows(rule, band):
+    """The symmetric form's residual g - sum_j m_j (p_i + p_j) F_ij x_ij (rho = 1, F_ij = W'(r_ij, h_ij) / r_ij) as a
+    linear map of the pressures: the residual of the hydrostatic pressures, then the least-squares pressure change
+    of the particles within `band` of the block's edge that makes it smallest over the particles away from the
+    lattice's edges."""
+    X, H, M, L = lattice(ZONE)
+    p0 = G * (TOP - X[:, 1])
+    eq = np.where((X[:, 0] > 6) & (X[:, 0] < 34) & (X[:, 1] > 4) & (X[:, 1] < 26))[0]
+    x0, y0, x1, y1 = ZONE
+    inside = (X[:, 0] > x0) & (X[:, 0] < x1) & (X[:, 1] > y0) & (X[:, 1] < y1)
+    edge = np.minimum.reduce([np.abs(X[:, 0] - x0), np.abs(X[:, 0] - x1), np.abs(X[:, 1] - y0), np.abs(X[:, 1] - y1)])
+    outside = np.hypot(np.maximum(0, np.maximum(x0 - X[:, 0], X[:, 0] - x1)),
+                       np.maximum(0, np.maximum(y0 - X[:, 1], X[:, 1] - y1)))
+    near = np.where(np.where(inside, edge, outside) < band)[0]
+    A = np.zeros((2 * len(eq), len(X)))
+    for k, i in enumerate(eq):
+        xij = X[i] - X
+        r = np.hypot(xij[:, 0], xij[:, 1])
+        r[i] = np.inf
+        f = dwdr(r, PAIR_H[rule](H[i], H)) / r
+        t = -(M * f)[:, None] * xij  # d a_i / d p_j, and d a_i / d p_i is their sum
+        A[2 * k:2 * k + 2, :] += t.T
+        A[2 * k:2 * k + 2, i] += t.sum(0)
+    gvec = np.tile([0.0, -G], len(eq))
+    r0 = A @ p0 + gvec
+    dp, *_ = np.linalg.lstsq(A[:, near], -r0, rcond=None)
+    r1 = r0 + A[:, near] @ dp
+    mag = lambda r: np.hypot(r[0::2], r[1::2])  # noqa: E731
+    lev = L[eq]
+    c0sq = 100.0 * G * TOP  # the tank's sound speed, mach factor 10 over the water's height: c0 = 10 sqrt(g H)
+    return (mag(r0)[lev == 0].max(), mag(r0)[lev == 1].max(), mag(r1)[lev == 0].max(), mag(r1)[lev == 1].max(),
+            np.abs(dp).max() / (G * TOP), np.abs(dp).max() / c0sq, len(near))
+
+
+def balance():
+    print("| h_ij | band (m) | residual before: coarse, fine | after: coarse, fine | max dp / (rho g H) | "
+          "max d rho / rho | particles changed |")
+    print("|---|---|---|---|---|---|---|")
+    for rule in ("mean (the paper's)", "quadratic mean"):
+        for band in (1.0, 2.0, 3.0):
+            b0c, b0f, b1c, b1f, dp, drho, n = balance_rows(rule, band)
+            print(f"| {rule} | {band:g} | {b0c:.2g}, {b0f:.3g} | {b1c:.2g}, {b1f:.3g} | {dp:.4f} | {drho:.2e} | {n} |")
+
+
 def main():
     if "--interface" in sys.argv[1:]:
         interface()
+        return
+    if "--balance" in sys.argv[1:]:
+        balance()
         return
     rows = [("uniform lattice, no jump", dict(form="symmetric", zone=(-9, -9, -8, -8))),
             ("paper: h_ij mean, daughters h/2", dict(form="symmetric"))]
