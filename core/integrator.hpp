@@ -34,6 +34,7 @@
 // evaluated at the finer rate, from both sides. Steps end with every bin synchronised, so refinement,
 // coarsening, output and checkpoints only ever see synchronised particles.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -113,7 +114,8 @@ class Integrator {
 
   /// neighbourhood_bins' workspace, reused from step to step.
   struct NeighbourhoodWork {
-    par::RangeMax<double> pace;  // -dt_limit_j / h_j of the non-wall particles with a limit, in store order
+    std::vector<std::uint32_t> fast;       // the particles whose limit could put a neighbour in a finer bin
+    std::vector<std::uint8_t> near_fast;   // 1 where a fluid particle has one of them for a neighbour
   };
 
   /// Each fluid particle's next bin for the coarse step dt0 from its limit over its kernel neighbourhood: the
@@ -124,41 +126,49 @@ class Integrator {
   /// steps only). With one global step every particle steps at C times the smallest limit of all; with its own
   /// limit alone, a particle at the tip of the dam break's surge front, stepping at C times its own, went wrong at
   /// 4x and 16x (docs/METHOD.md, "the surge front").
-  /// Only a neighbour whose scaled limit is a bin shorter than i's own can change i's bin, and in a region of
-  /// one flow few are: the neighbours are walked only where a lower bound on their scaled limits, from the
-  /// smallest dt_j / h_j in the store and then in each of i's candidate runs (a range-maximum table, as the
-  /// limiter's), would put i in a finer bin: only those runs are walked. The result is the same as walking every
-  /// particle's neighbours.
+  /// A neighbour j moves i from its own bin b_i to a finer one only when dt_j h_i / h_j < dt0 2^-b_i / C, i.e. when
+  /// its pace dt_j / h_j is below dt0 2^-b_i / (C h_i). The largest of these thresholds over the fluid bounds them
+  /// all, and few particles are below it (the stiff few: 0.26 % of the particle-steps of the paper's dam break per
+  /// level). Those mark their neighbours, and only a marked particle walks its neighbourhood; every other keeps
+  /// its own bin, which walking would give it too. So the result is that of walking every particle's neighbours,
+  /// and does not depend on the order or the threads (a mark is a set bit).
   template <int D>
   void neighbourhood_bins(const ParticleView<D>& s, const CellGrid<D>& grid, double dt0, double cfl,
                           NeighbourhoodWork& work) const {
-    const double inf = std::numeric_limits<double>::infinity();
-    work.pace.build(s.n, [&](std::size_t j) {
-      return s.kind[j] != Kind::wall && s.dt_limit[j] > 0.0 ? -(s.dt_limit[j] / s.h[j]) : -inf;
+    // Each fluid particle's bin from its own limit, and the largest pace a neighbour could move it a bin below.
+    const double threshold = par::reduce(
+        s.n, 0.0,
+        [&](std::size_t i) {
+          if (s.kind[i] != Kind::fluid) return 0.0;
+          const int b = bin_for(s, i, dt0, cfl, s.dt_limit[i]);
+          s.next_bin[i] = b;
+          if (!(s.dt_limit[i] > 0.0) || b >= bin_cap() || !std::isfinite(dt0)) return 0.0;
+          return dt0 * kBinWeight[static_cast<std::size_t>(b)] / (cfl * s.h[i]);
+        },
+        [](double a, double b) { return std::max(a, b); });
+    if (!(threshold > 0.0)) return;
+    // The particles below it, with a margin (1e-9 relative) far beyond the roundings of the quotients and products
+    // that compare a scaled limit with a bin's step, so that every neighbour that could move a bin is among them.
+    const double bound = threshold * (1.0 + 1e-9);
+    work.fast.clear();
+    for (std::size_t j = 0; j < s.n; ++j) {
+      if (s.kind[j] != Kind::wall && s.dt_limit[j] > 0.0 && s.dt_limit[j] / s.h[j] < bound)
+        work.fast.push_back(static_cast<std::uint32_t>(j));
+    }
+    if (work.fast.empty()) return;
+    work.near_fast.assign(s.n, 0);
+    par::parallel_for(work.fast.size(), [&](std::size_t k) {
+      grid.for_each_neighbour(work.fast[k], s.x, s.h, [&](std::uint32_t i, double) {
+        if (s.kind[i] == Kind::fluid) std::atomic_ref<std::uint8_t>(work.near_fast[i]).store(1, std::memory_order_relaxed);
+      });
     });
-    const double slowest = s.n > 0 ? -work.pace.max(0, s.n) : inf;  // the smallest dt_j / h_j in the store
     par::parallel_for(s.n, [&](std::size_t i) {
-      if (s.kind[i] != Kind::fluid) return;
-      const double own = s.dt_limit[i];
-      const int b = bin_for(s, i, dt0, cfl, own);
-      s.next_bin[i] = b;
-      if (!(own > 0.0) || b >= bin_cap()) return;
-      // A lower bound on every computed dt_j (h_i / h_j) with dt_j / h_j >= pace: h_i pace less a few roundings
-      // of the two products and the quotient (1e-12 relative is far beyond them). bin_from is non-increasing in
-      // the limit, so a bound whose bin is not finer than b proves that no such neighbour changes it.
-      const auto finer = [&](double pace) {
-        return std::isfinite(pace) && bin_from(b, dt0, cfl, (s.h[i] * pace) * (1.0 - 1e-12)) > b;
-      };
-      if (!finer(slowest)) return;
-      // One scan of the candidate runs: a run is walked only where its bound would put i in a finer bin. A
-      // neighbour in a run that is not walked has a scaled limit whose bin is not finer than b, so it cannot change
-      // the bin, which is the finest over i's own limit and each neighbour's (bin_from is non-increasing).
-      double m = own;
-      grid.for_each_neighbour_in(
-          i, s.x, s.h, [&](std::uint32_t lo, std::uint32_t up) { return up > lo && finer(-work.pace.max(lo, up)); },
-          [&](std::size_t j, double) {
-            if (s.kind[j] != Kind::wall && s.dt_limit[j] > 0.0) m = std::min(m, s.dt_limit[j] * (s.h[i] / s.h[j]));
-          });
+      if (!work.near_fast[i] || s.next_bin[i] >= bin_cap()) return;
+      double m = s.dt_limit[i];
+      if (!(m > 0.0)) return;
+      grid.for_each_neighbour(i, s.x, s.h, [&](std::size_t j, double) {
+        if (s.kind[j] != Kind::wall && s.dt_limit[j] > 0.0) m = std::min(m, s.dt_limit[j] * (s.h[i] / s.h[j]));
+      });
       s.next_bin[i] = bin_for(s, i, dt0, cfl, m);
     });
   }
