@@ -237,7 +237,7 @@ class CellGrid {
   /// The runs that can hold a neighbour of a particle at p with smoothing length h: in layer l, those within
   /// h + max_h(l). Only the layers for which keep(begin, end) holds, given the layer's particle range.
   template <class F, class Keep>
-  void for_each_support_run(const VecD& p, double h, F&& f, Keep&& keep) const {
+  SPH_ALWAYS_INLINE void for_each_support_run(const VecD& p, double h, F&& f, Keep&& keep) const {
     const std::uint32_t* start = sorted_.bucket_start.data();
     for (int l = 0; l < count_; ++l) {
       const Layer& L = layers_[static_cast<std::size_t>(l)];
@@ -313,7 +313,7 @@ class CellGrid {
   /// in floating point. A query square that misses the layer's cells on some axis holds none of its particles
   /// (they lie in [origin, origin + dims * cell)), and is skipped.
   template <class F>
-  void scan(const Layer& L, const VecD& p, double reach, F& f) const {
+  SPH_ALWAYS_INLINE void scan(const Layer& L, const VecD& p, double reach, F& f) const {
     if (L.cells == 0) return;
     const double r = reach * (1.0 + 1e-9) + 1e-15 * p.cwiseAbs().maxCoeff();
     for (int k = 0; k < D; ++k) {

@@ -163,7 +163,7 @@ class PairSweep {
           // Only the due candidates of a run when i is not due and their list is there: a pair with i is due only
           // when j is (b_ij = b_j >= active bin), and walls pair only with due particles.
           const bool due_only = !all && act.due_index != nullptr;
-          grid.for_each_support_run(xi, hi, [&](std::uint32_t b, std::uint32_t e) {
+          grid.for_each_support_run(xi, hi, [&](std::uint32_t b, std::uint32_t e) SPH_ALWAYS_INLINE {
             if (!holds_due(b, e)) return;
             const std::uint32_t first = due_only ? act.due_prefix[b] : b;
             const std::uint32_t last = due_only ? act.due_prefix[e] : e;

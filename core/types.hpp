@@ -5,6 +5,16 @@
 #include <stdexcept>
 #include <string>
 
+// Forces a function (or a lambda: after its parameter list) to be inlined into its caller. The neighbour scans
+// (CellGrid::scan and its callers) and the pair loops they call back must end up in one function: when GCC 12 kept
+// the per-run callback out of line, every captured accumulator and the pair's scratch lived in memory behind the
+// closure, and the 2D pair sweep took 2.6 times as long (docs/PERFORMANCE.md, "A scan that stopped inlining").
+#if defined(__GNUC__)
+#define SPH_ALWAYS_INLINE __attribute__((always_inline))
+#else
+#define SPH_ALWAYS_INLINE
+#endif
+
 namespace sph {
 
 /// A point or vector in D dimensions (D = 2 or 3).
