@@ -61,6 +61,25 @@ void BM_Sweep_Effects(benchmark::State& state, bool viscosity, bool lennard_jone
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * fluid));
 }
 
+// The last evaluation of a step with time bins (Activity::rebin, every step of a per-level run): each pair once
+// at weight 1 and then added at this step's and at the next step's weight, against the plain sweep of the same
+// store and effects (BM_Sweep_ViscosityAndLennardJones). Issue #16: what a per-level run's closing evaluations
+// cost per pair over a single-rate run's.
+void BM_Sweep_Rebin(benchmark::State& state) {
+  omp_set_num_threads(static_cast<int>(state.range(1)));
+  DamBreakSpec spec = block(static_cast<std::size_t>(state.range(0)));
+  spec.viscosity = true;
+  spec.lennard_jones = true;
+  Simulation sim = make_dam_break(spec);
+  for (int k = 0; k < 20; ++k) sim.step();
+  const auto sweep = make_sweep(sim.settings());
+  Activity act;
+  act.rebin = true;
+  const std::size_t fluid = sim.diagnostics().fluid;
+  for (auto _ : state) benchmark::DoNotOptimize(sweep->run(sim.store().view(), sim.grid(), act));
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * fluid));
+}
+
 void BM_Sweep_PressureOnly(benchmark::State& s) { BM_Sweep_Effects(s, false, false); }
 void BM_Sweep_Viscosity(benchmark::State& s) { BM_Sweep_Effects(s, true, false); }
 void BM_Sweep_LennardJones(benchmark::State& s) { BM_Sweep_Effects(s, false, true); }
@@ -135,6 +154,7 @@ BENCHMARK(BM_Sweep_Viscosity)->Args({100000, 1})->Args({100000, 2})->Unit(benchm
 BENCHMARK(BM_Sweep_LennardJones)->Args({100000, 1})->Args({100000, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Sweep_ViscosityAndLennardJones)->Args({100000, 1})->Args({100000, 2})
     ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Sweep_Rebin)->Args({100000, 1})->Args({100000, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 
