@@ -322,39 +322,20 @@ class CellGrid {
     const auto lo = L.coords(p - VecD::Constant(r));
     const auto hi = L.coords(p + VecD::Constant(r));
     const std::uint32_t* start = sorted_.bucket_start.data() + L.first;
+    // One run per row of cells along x, the whole row (rows in memory order). The rows are not clipped to the
+    // query's ball: f31f907 clipped them (3D candidates 189 -> 131 per particle-step), but each row's distance,
+    // square root and end cells cost more than the candidates they save, in 2D and in 3D. Binaries run in turn,
+    // one thread, 1e5 particles (docs/PERFORMANCE.md, 2026-12-03): the 2D pressure sweep took 44-48 ms clipped,
+    // 28-34 ms with whole rows; the 3D still tank's step 203-231 ms and 155-219 ms; skipping only the rows
+    // beyond reach, without shortening the others, kept most of the cost (2D sweep 30-34 ms against 22-26 ms).
+    const auto x_len = static_cast<std::size_t>(hi[0] - lo[0]);
     if constexpr (D == 1) {
-      f(start[static_cast<std::size_t>(lo[0])], start[static_cast<std::size_t>(hi[0]) + 1]);
+      f(start[static_cast<std::size_t>(lo[0])], start[static_cast<std::size_t>(lo[0]) + x_len + 1]);
     } else {
-      // Each row of cells along x is clipped to the part of the query's ball it can reach: with d the distance
-      // from p to the row's cells across x (its other coordinates), only |x - p_x| <= sqrt(r^2 - d^2) can hold a
-      // particle within r, and a row with d > r holds none. The cells' bounds are widened by `pad` (rounding of
-      // coords(), which put each particle in its cell), and the layer's edge cells reach to infinity (coords()
-      // clamps into them), so no particle within r is left out: the same candidates within r, in the same order.
-      const double r2 = r * r;
-      const double pad = 1e-9 * L.cell_size + 1e-15 * p.cwiseAbs().maxCoeff();
       std::array<std::int64_t, D> q = lo;
       for (;;) {
-        double d2 = 0.0;
-        for (int k = 1; k < D; ++k) {
-          const double cell_lo = q[k] == 0 ? -std::numeric_limits<double>::infinity()
-                                            : L.origin[k] + static_cast<double>(q[k]) * L.cell_size - pad;
-          const double cell_hi = q[k] == L.dims[k] - 1 ? std::numeric_limits<double>::infinity()
-                                                       : L.origin[k] + static_cast<double>(q[k] + 1) * L.cell_size + pad;
-          const double gap = p[k] < cell_lo ? cell_lo - p[k] : (p[k] > cell_hi ? p[k] - cell_hi : 0.0);
-          d2 += gap * gap;
-        }
-        if (d2 <= r2) {
-          const double half = std::sqrt(r2 - d2);
-          std::int64_t x_lo = lo[0], x_hi = hi[0];
-          if (d2 > 0.0) {  // only the x index of the clipped row's ends (the same arithmetic as coords())
-            x_lo = std::max(x_lo, L.coord(0, p[0] - half));
-            x_hi = std::min(x_hi, L.coord(0, p[0] + half));
-          }
-          std::array<std::int64_t, D> row = q;
-          row[0] = x_lo;
-          const std::size_t first = L.linear(row);
-          f(start[first], start[first + static_cast<std::size_t>(x_hi - x_lo) + 1]);
-        }
+        const std::size_t first = L.linear(q);
+        f(start[first], start[first + x_len + 1]);
         int k = 1;
         while (k < D && q[k] == hi[k]) {
           q[k] = lo[k];
