@@ -10,6 +10,7 @@ stiffness s_i, and the count of particles with s_i > 1.05; --coarse adds the coa
 errors, each with a non-zero exit: a folder that is not a run, a scene without time.cfl, a run without frames.
 Exit status 0 on success, 1 on failure.
 """
+import copy
 import csv
 import json
 import os
@@ -24,26 +25,19 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 from checks import Checks  # noqa: E402
+import test_read_output  # noqa: E402
 
 TOOL = os.path.join(HERE, "step_limits.py")
 FLUID = 0  # Kind::fluid in the frames' kind field (core/types.hpp)
 
-# A column that collapses: the velocity criterion refines its front within the first checks, so two levels are
-# present at the later frames. Per-level steps, so the levels have their own bins.
-SCENE = {
-    "name": "step_limits_check",
-    "container": {"lo": [0, 0], "hi": [4, 3]},
-    "fluid": [{"shape": "rectangle", "lo": [0, 0], "hi": [1, 2], "spacing": 0.1, "hydrostatic": True}],
-    "material": {"rho0": 1000, "mach_factor": 10, "reference_height": 2},
-    "effects": {
-        "gravity": [0, -9.81],
-        "artificial_viscosity": {"alpha": 0.02},
-        "ghost_walls": "free-slip",
-        "refinement": {"criterion": "velocity", "v_threshold": 0.4, "check_interval": 10, "max_level": 1},
-    },
-    "time": {"end": 0.15, "output_interval": 0.005, "cfl": 0.2, "stepping": "per_level"},
-    "output": {"frame_interval": 0.025},
-}
+# test_read_output's small column, which collapses: the velocity criterion refines its front within the first checks,
+# so two levels are present at the later frames. Here with per-level steps, so the levels have their own bins, and
+# run longer, with more frames.
+SCENE = copy.deepcopy(test_read_output.SCENE)
+SCENE["name"] = "step_limits_check"
+SCENE["effects"]["refinement"]["check_interval"] = 10
+SCENE["time"] = {"end": 0.15, "output_interval": 0.005, "cfl": 0.2, "stepping": "per_level"}
+SCENE["output"] = {"frame_interval": 0.025}
 
 
 def run(app, scene, folder):
