@@ -75,14 +75,9 @@ TEST(Sweep, TimeBinsEqualBruteForceIn3D) {
   for (const int active : {1, 0}) {
     SCOPED_TRACE(testing::Message() << "active bin " << active);
     sph::Activity act{active, sph::Integrator::kMaxBin};
-    std::vector<std::uint32_t> prefix(s.size() + 1, 0), due;
-    for (std::size_t i = 0; i < s.size(); ++i) {
-      const bool is_due = s.kind[i] != Kind::wall && act.bin(s.bin[i]) >= active;
-      prefix[i + 1] = prefix[i] + (is_due ? 1u : 0u);
-      if (is_due) due.push_back(static_cast<std::uint32_t>(i));
-    }
-    act.due_prefix = prefix.data();
-    act.due_index = due.data();  // the particles that are not due walk the due ones only
+    const sph::test::DueLists due = sph::test::due_lists(s, act);
+    act.due_prefix = due.prefix.data();
+    act.due_index = due.index.data();  // the particles that are not due walk the due ones only
     const sph::SweepLimits lim = sweep->run(s.view(), grid, act);
     expect_rates_match_brute_force(s, lim, st, "3D bins", act);
   }

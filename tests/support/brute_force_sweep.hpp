@@ -1,5 +1,6 @@
 #pragma once
-// The pair sweep's brute-force twin for the tests (tests/test_sweep.cpp in 2D, tests/test_sweep_3d.cpp in 3D):
+// The pair sweep's brute-force twin for the tests (tests/test_sweep.cpp and test_sweep_bins.cpp in 2D, test_sweep_3d.cpp
+// in 3D):
 // eqs. (5), (6), (9) and (10) over all pairs, written from PHYSICS.md, with the optional effects and time bins,
 // and the comparison of a sweep's rates and limits against it.
 #include <gtest/gtest.h>
@@ -208,5 +209,48 @@ std::size_t changed_density_rates(const ReferenceT<D>& with, const ReferenceT<D>
     n += std::abs(with.drho[i] - without.drho[i]) > 1e-6 * with.drho_scale[i];
   return n;
 }
+
+/// The due particles of an activity as the sweep's optional lists (Activity::due_prefix, due_index): fluid and ghosts
+/// whose bin is at least the active bin, in store order. Set act.due_prefix = prefix.data() (and due_index) to use them.
+struct DueLists {
+  std::vector<std::uint32_t> prefix, index;
+};
+template <int D>
+DueLists due_lists(const ParticleStore<D>& s, const sph::Activity& act) {
+  DueLists l;
+  l.prefix.assign(s.size() + 1, 0);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const bool is_due = s.kind[i] != Kind::wall && act.bin(s.bin[i]) >= act.active_bin;
+    l.prefix[i + 1] = l.prefix[i] + (is_due ? 1u : 0u);
+    if (is_due) l.index.push_back(static_cast<std::uint32_t>(i));
+  }
+  return l;
+}
+
+/// The 2D twins' settings (tests/test_sweep.cpp, tests/test_sweep_bins.cpp): no ghost walls, and the optional effects
+/// on request.
+inline SolverSettings twin_settings(bool viscosity, bool lennard_jones) {
+  SolverSettings st;
+  st.eos.rho0 = 1000.0;
+  st.eos.c0 = 25.0;
+  st.gravity = Vec<2>(0.0, -9.81);
+  st.ghosts.reset();
+  if (viscosity) {
+    st.viscosity = ViscositySettings{0.2, 0.5};
+  } else {
+    st.viscosity.reset();
+  }
+  if (lennard_jones) st.lennard_jones = LennardJonesSettings{50.0, 0.5, 0.25};
+  return st;
+}
+
+/// A mixed-level cloud plus ghost-kind particles (sources only) and a row of wall particles at y = 0.
+inline ParticleStore<2> twin_cloud(const SolverSettings& st, std::uint32_t seed) {
+  ParticleStore<2> s = random_cloud(700, 10.0, 0.5, st.eos, seed, 1.5);
+  for (std::size_t i = 0; i < s.size(); i += 7) s.kind[i] = Kind::ghost;
+  for (int k = 0; k <= 40; ++k) add_particle(s, wall_particle<2>(Vec<2>(0.25 * k, 0.0), 0.125, st.eos.rho0), st.eos);
+  return s;
+}
+
 
 }  // namespace sph::test
