@@ -97,6 +97,7 @@ DiagnosticsT<D> compute_diagnostics(const ParticleStore<D>& store, const TaitEqu
           ++a.walls;
           return;
         }
+        if (is_passive(store.role[i])) return;  // a copy (buffered coupling): its mass is counted in the active level's
         ++a.fluid;
         a.mass.add(m[i]);
         a.ke.add(0.5 * m[i] * v[i].squaredNorm());
@@ -131,7 +132,7 @@ DiagnosticsT<D> compute_diagnostics(const ParticleStore<D>& store, const TaitEqu
   constexpr std::size_t kLevelSlots = 32;
   std::array<std::uint64_t, kLevelSlots> levels{};
   for (std::size_t i = 0; i < store.size(); ++i) {
-    if (kind[i] != Kind::fluid) continue;
+    if (kind[i] != Kind::fluid || is_passive(store.role[i])) continue;
     ++levels[std::min(kLevelSlots - 1, static_cast<std::size_t>(std::max(0, store.level[i])))];
   }
   if (comm != nullptr && comm->distributed()) {

@@ -42,6 +42,7 @@ struct ParticleView {
   double* dt_limit = nullptr;
   Vec<D>* jerk = nullptr;
   double* density_jerk = nullptr;
+  Role* role = nullptr;
 };
 
 template <int D>
@@ -89,6 +90,7 @@ class ParticleStore {
   // in a run and after a merge; a daughter keeps its parent's.
   Field<VecD> jerk{"jerk", "m/s^3"};
   Field<double> density_jerk{"density_jerk", "kg/m^3/s^2"};
+  Field<Role> role{"role", "1"};  // core/types.hpp
 
   /// The registry: every field as a pointer to member. Adding a field above and here is all it takes for
   /// every operation (gather, compaction, expansion, copies, output, checkpoints) to carry it.
@@ -99,7 +101,8 @@ class ParticleStore {
                            &ParticleStore::vh, &ParticleStore::rhoh, &ParticleStore::level_time,
                            &ParticleStore::origin, &ParticleStore::kick, &ParticleStore::kick_rho,
                            &ParticleStore::bin, &ParticleStore::next_bin, &ParticleStore::stiffness,
-                           &ParticleStore::dt_limit, &ParticleStore::jerk, &ParticleStore::density_jerk);
+                           &ParticleStore::dt_limit, &ParticleStore::jerk, &ParticleStore::density_jerk,
+                           &ParticleStore::role);
   }
 
   /// Visits every field. f is called with each Field<T>&.
@@ -206,7 +209,7 @@ class ParticleStore {
     return {size(), x.data(), v.data(), rho.data(), p.data(), m.data(), h.data(), d.data(),
             level.data(), kind.data(), id.data(), drho.data(), a.data(), vh.data(), rhoh.data(), level_time.data(),
             origin.data(), kick.data(), kick_rho.data(), bin.data(), next_bin.data(), stiffness.data(), dt_limit.data(),
-            jerk.data(), density_jerk.data()};
+            jerk.data(), density_jerk.data(), role.data()};
   }
 
   /// Bytes held by every field (data and scratch), for memory reports.
@@ -219,7 +222,7 @@ class ParticleStore {
   /// Bytes one particle occupies across all fields.
   static constexpr std::size_t bytes_per_particle() {
     return 6 * sizeof(VecD) + 12 * sizeof(double) + 3 * sizeof(std::int32_t) + sizeof(Kind) + sizeof(ParticleId) +
-           sizeof(Origin);
+           sizeof(Origin) + sizeof(Role);
   }
 
  private:

@@ -72,6 +72,9 @@ class SimulationT {
   explicit SimulationT(Settings settings);
 
   const Settings& settings() const { return settings_; }
+  /// How levels interact from now on (effects.refinement.coupling; the refinement stage sets it when added).
+  void set_coupling(LevelCoupling coupling) { settings_.coupling = coupling; }
+  bool buffered() const { return settings_.coupling == LevelCoupling::buffered; }
   ParticleStore<D>& store() { return store_; }
   const ParticleStore<D>& store() const { return store_; }
   const CellGrid<D>& grid() const { return grid_; }

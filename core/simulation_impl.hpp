@@ -10,6 +10,7 @@
 #include <string>
 
 #include "core/neighbour_cells.hpp"
+#include "core/refinement/buffer.hpp"
 #include "parallel/parallel_for.hpp"
 #include "parallel/scan.hpp"
 
@@ -202,7 +203,8 @@ void SimulationT<D>::refresh() {
   par::parallel_for(t.n, [&](std::size_t i) {
     if (t.kind[i] != Kind::wall) t.bin[i] = t.next_bin[i];
   });
-  limits_ = global(sweep_->run(store_.view(), grid_, integrator_.activity(1, 0)));
+  if (buffered()) refine::interpolate_passive(store_.view(), grid_, settings_.eos);
+  limits_ = global(sweep_->run(store_.view(), grid_, activity(1, 0)));
   dt_ = next_dt();
 }
 
@@ -384,6 +386,7 @@ void SimulationT<D>::store_restored() {
 template <int D>
 Activity SimulationT<D>::activity(int k, int finest) {
   Activity act = integrator_.activity(k, finest);
+  act.own_level_only = buffered();
   if (act.active_bin == 0) return act;  // every particle is due
   const auto s = store_.view();
   due_prefix_.resize(s.n + 1);
@@ -429,7 +432,9 @@ StepInfo SimulationT<D>::step(double dt_cap) {
           s.n, SmoothingRange{},
           [&](SmoothingRange& r, std::size_t i) {
             if (k == 1 && watch) last_good_.copy_particle(store_, i);
-            if (s.kind[i] == Kind::fluid) {
+            if (s.kind[i] == Kind::fluid && is_passive(s.role[i])) {
+              s.x[i] += tau * s.v[i];  // buffered levels: a passive particle moves with its fitted velocity
+            } else if (s.kind[i] == Kind::fluid) {
               if (k == 1) {
                 integ.open(s, i, dt);
               } else {
@@ -466,6 +471,8 @@ StepInfo SimulationT<D>::step(double dt_cap) {
         build_neighbours(hr);
       }
       if (choose) rebin = choose_bins_on_grid();
+      // Buffered levels: the passive particles take the active ones' state as predicted for this evaluation.
+      if (buffered()) refine::interpolate_passive(store_.view(), grid_, settings_.eos);
       Activity act = activity(k, finest);
       act.rebin = rebin;
       act.dt0 = dt;
@@ -491,9 +498,11 @@ StepInfo SimulationT<D>::step(double dt_cap) {
     auto s = store_.view();
     par::parallel_for(s.n, [&](std::size_t i) {
       if (s.kind[i] != Kind::fluid) return;
-      integ.kick(s, i, dt, true);
+      if (!is_passive(s.role[i])) integ.kick(s, i, dt, true);
       s.bin[i] = s.next_bin[i];
     });
+    // ... and again after the closing kick, from the state the step ends with (output, the next drift).
+    if (buffered()) refine::interpolate_passive(store_.view(), grid_, settings_.eos);
     limits_ = step_limits;
     count_work(finest, step_limits);
   }

@@ -58,6 +58,9 @@ struct SolverSettingsT {
   TimeStepping stepping = TimeStepping::global;
   int bin_jump = kDefaultBinJump;  // per_level: neighbours' bins at most this far apart (Integrator::limit_bins)
   TimePredictor predictor = TimePredictor::extrapolated;  // Integrator::drift
+  // How levels interact (core/types.hpp). The refinement stage sets it from effects.refinement.coupling when it is
+  // added (refine::add_refinement_stage), the scene key's one home.
+  LevelCoupling coupling = LevelCoupling::mixed;
   WatchdogSettings watchdog;
 };
 

@@ -74,6 +74,9 @@ struct Activity {
   // the sweep sets its jerk from the two. 0 for an evaluation that does not end a step (Simulation::refresh, after a
   // refinement pass or at set-up): the jerk is then left as it is.
   double dt0 = 0.0;
+  // Buffered levels (LevelCoupling::buffered, core/refinement/buffer.hpp): a fluid particle pairs only with fluid and
+  // ghosts of its own level, and a passive particle gets no sums (as a wall); wall particles pair as always.
+  bool own_level_only = false;
   int bin(std::int32_t b) const { return b < bin_cap ? static_cast<int>(b) : bin_cap; }
 };
 
@@ -139,7 +142,7 @@ class PairSweep {
         s.n, init,
         [&](std::size_t i) {
           SweepLimits lim;
-          if (s.kind[i] != Kind::fluid) {
+          if (s.kind[i] != Kind::fluid || is_passive(s.role[i])) {
             s.a[i].setZero();
             s.drho[i] = 0.0;
             s.kick[i].setZero();
@@ -189,6 +192,7 @@ class PairSweep {
               const double r2 = xij.squaredNorm();
               const double support = hi + s.h[j];
               if (r2 >= support * support || j == i) continue;
+              if (act.own_level_only && s.kind[j] != Kind::wall && s.level[j] != s.level[i]) continue;
               if (s.kind[j] == Kind::wall && !((!Binned || due) && r2 < wall_reach2)) continue;
               pr.j = j;
               pr.xij = xij;

@@ -61,6 +61,21 @@ enum class Kind : std::uint8_t { fluid = 0, wall = 1, ghost = 2, halo = 3 };
 /// (`fresh_merge` until the refinement check after that merge, which does not split it, then `merge`).
 enum class Origin : std::uint8_t { setup = 0, split = 1, fresh_merge = 2, merge = 3 };
 
+/// effects.refinement.coupling: how particles of different levels interact. `mixed` (the paper's): every pair within
+/// reach, whatever the levels, with h_ij = (h_i + h_j) / 2. `buffered`: a particle's SPH sums take only particles of
+/// its own level; each level's lattice is completed where another level is active by passive particles that take
+/// their velocity and density from that level (core/refinement/buffer.hpp; docs/METHOD.md, "Buffered levels").
+enum class LevelCoupling { mixed, buffered };
+
+/// A particle's part in its level with buffered coupling (always `active` with mixed coupling). Active particles
+/// carry the SPH equations; passive ones complete their level's lattice and copy another level's state.
+///   active: a particle without daughters;
+///   shadow: a passive parent whose daughters are active (it stays where they are, inside a refined zone);
+///   host:   an active parent whose daughters are buffer particles (at the edge of a refined zone);
+///   buffer: a passive daughter.
+enum class Role : std::uint8_t { active = 0, shadow = 1, host = 2, buffer = 3 };
+inline constexpr bool is_passive(Role r) { return r == Role::shadow || r == Role::buffer; }
+
 /// time.stepping (core/integrator.hpp): one global step (the paper's), or power-of-two steps per refinement level.
 enum class TimeStepping { global, per_level };
 /// time.predictor (core/integrator.hpp, Integrator::drift): how v and rho are predicted for an evaluation inside or

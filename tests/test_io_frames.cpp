@@ -92,7 +92,7 @@ TEST(IoFrames, EveryFieldReadsBackAsWrittenWithoutGhosts) {
     EXPECT_EQ(io::read_frame_field(file, "frame_000003", name), as_doubles(f, keep)) << name;
     ++fields;
   });
-  EXPECT_EQ(fields, 24);
+  EXPECT_EQ(fields, 25);
 }
 
 /// A string attribute of an HDF5 object ("<none>" when absent), read with the HDF5 API directly.
@@ -142,7 +142,7 @@ TEST(IoFrames, EveryDatasetCarriesItsUnits) {
       {"acceleration", "m/s^2"}, {"velocity_half", "m/s"}, {"density_half", "kg/m^3"}, {"level_time", "s"},
       {"origin", "1"},         {"kick_rate", "m/s^2"},      {"kick_density_rate", "kg/m^3/s"},
       {"time_bin", "1"}, {"time_step_limit", "s"},       {"next_time_bin", "1"},      {"acoustic_stiffness", "1"},
-      {"jerk", "m/s^3"}, {"density_jerk", "kg/m^3/s^2"}};
+      {"jerk", "m/s^3"}, {"density_jerk", "kg/m^3/s^2"}, {"role", "1"}};
   std::string time_units;
   const fs::path frame = tmp.path() / "frame.h5";
   (void)io::write_frame(frame, "frame_000000", sim.store(), sim.time(), sim.step_count(), 0, {});
@@ -211,7 +211,7 @@ TEST(IoFrames, XdmfDatasetPathsAndShapesMatchTheHdf5Files) {
     const auto values = io::read_frame_field(file, dataset.substr(1, slash - 1), dataset.substr(slash + 1));
     EXPECT_EQ(values.size(), n * components) << dataset;
   }
-  EXPECT_EQ(items, 3 * 24);
+  EXPECT_EQ(items, 3 * 25);
 }
 
 TEST(IoFrames, CheckpointRestoresEveryFieldAndTheNextId) {

@@ -202,6 +202,25 @@ TEST(Runner, ResumedRunWithPerLevelStepsIsBitwiseIdenticalToTheUninterruptedOne)
   });
 }
 
+// The same with buffered levels (effects.refinement.coupling = "buffered") and two levels in a zone: the roles and the
+// passive particles' fitted state travel in the checkpoint, and the resumed run fits them as the uninterrupted one.
+TEST(Runner, ResumedRunWithBufferedLevelsIsBitwiseIdenticalToTheUninterruptedOne) {
+  scene::Scene s = tiny_scene();
+  scene::Refinement r;
+  r.criterion = scene::Criterion::zone;
+  r.zone = scene::Rect{Vec<2>(0.0, 0.0), Vec<2>(0.3, 0.3)};
+  r.check_interval = 10;
+  r.max_level = 2;
+  r.coupling = LevelCoupling::buffered;
+  s.effects.refinement = r;
+  s.time.end = test::short_runs() ? 0.1 : 0.15;
+  expect_resume_is_bitwise(s, [](const ParticleStore<2>& st) {
+    std::size_t passive = 0;
+    for (std::size_t i = 0; i < st.size(); ++i) passive += is_passive(st.role[i]) ? 1 : 0;
+    EXPECT_GT(passive, 0u) << "no passive particle: the test would not see their state";
+  });
+}
+
 // A finished run extended with a later time.end (--resume --set time.end=...) is the run that went to the
 // later end without stopping, bitwise, at 1 and 2 threads. The first run's last step is shortened to land on
 // its end (0.043 s falls between steps), which the longer run never does.

@@ -40,6 +40,8 @@ T value_for(ParticleId id, int salt) {
     return static_cast<Kind>((id + static_cast<ParticleId>(salt)) % 3);
   } else if constexpr (std::is_same_v<T, Origin>) {
     return static_cast<Origin>((id + static_cast<ParticleId>(salt)) % 4);
+  } else if constexpr (std::is_same_v<T, Role>) {
+    return static_cast<Role>((id + static_cast<ParticleId>(salt)) % 4);
   } else if constexpr (requires { T::RowsAtCompileTime; }) {
     T v;
     for (Eigen::Index k = 0; k < v.size(); ++k) v[k] = base + 0.5 + static_cast<double>(k) * 1e-3;

@@ -566,3 +566,26 @@ TEST(SceneParser, MissingFileIsASceneError) {
 }
 
 }  // namespace
+
+TEST(SceneParser, BufferedCouplingIsRefusedWhereItIsNotBuiltYet) {
+  Json doc = full_scene();
+  doc["effects"]["refinement"]["coupling"] = "buffered";
+  ASSERT_EQ(error_of(doc), "");
+  const Scene s = scene_from_json(doc);
+  EXPECT_EQ(s.effects.refinement->coupling, sph::LevelCoupling::buffered);
+  EXPECT_EQ(scene_from_json(scene_to_json(s)), s);
+  const std::string refused = "scene error: effects.refinement.coupling: \"buffered\" ";
+  Json coarsening = doc;
+  coarsening["effects"]["refinement"]["coarsening"] = Json::object();
+  EXPECT_EQ(error_of(coarsening).rfind(refused + "does not coarsen yet", 0), 0u) << error_of(coarsening);
+  Json per_level = doc;
+  per_level["time"]["stepping"] = "per_level";
+  EXPECT_EQ(error_of(per_level).rfind(refused + "needs time.stepping \"global\"", 0), 0u) << error_of(per_level);
+  Json velocity = doc;
+  velocity["effects"]["refinement"] = Json{{"v_threshold", 5}, {"coupling", "buffered"}};
+  EXPECT_EQ(error_of(velocity).rfind("scene error: effects.refinement.coupling: unknown key; allowed for criterion velocity", 0),
+            0u)
+      << error_of(velocity);
+  doc["effects"]["refinement"]["coupling"] = "apr";
+  EXPECT_EQ(error_of(doc), "scene error: effects.refinement.coupling: must be one of: mixed, buffered (got 'apr')");
+}

@@ -85,6 +85,8 @@ struct H5Traits<Kind> : ByteEnumTraits<Kind> {};
 template <>
 struct H5Traits<Origin> : ByteEnumTraits<Origin> {};
 template <>
+struct H5Traits<Role> : ByteEnumTraits<Role> {};
+template <>
 struct H5Traits<std::uint64_t> {
   static hid_t type() { return H5T_NATIVE_UINT64; }
   static constexpr int components = 1;

@@ -77,12 +77,14 @@ struct ReferenceIn {
 using Reference = ReferenceIn<2>;
 
 template <int D>
-ReferenceIn<D> find_reference(const ParticleStore<D>& store, const NeighbourQueryIn<D>& query, std::size_t i) {
+ReferenceIn<D> find_reference(const ParticleStore<D>& store, const NeighbourQueryIn<D>& query, std::size_t i,
+                              bool same_level = false) {
   ReferenceIn<D> ref;
   double best = -1.0;
   ParticleId best_id = 0;
   query.for_each_fluid_neighbour(i, [&](std::size_t j, double r) {
     if (r <= 0.0) return;
+    if (same_level && store.level[j] != store.level[i]) return;  // buffered coupling: the level's own lattice
     const double F = 0.5 * (store.d[i] + store.d[j]) / r;
     // Of equal F (a lattice's equally near neighbours), the lowest id: the choice is the particles' own, whatever
     // order the query visits them in (on a rank, its grid holds only part of the particles, issue #19).

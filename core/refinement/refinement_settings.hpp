@@ -3,6 +3,7 @@
 #include <optional>
 
 #include "core/boundary/wall.hpp"
+#include "core/types.hpp"
 
 namespace sph::refine {
 
@@ -43,6 +44,7 @@ struct RefinementSettings {
   int check_interval = 100; // steps between checks
   int max_level = 1;        // daughters of level max_level are never refined
   std::optional<CoarseningSettings> coarsening;  // none: nothing ever merges
+  LevelCoupling coupling = LevelCoupling::mixed;  // core/types.hpp, core/refinement/buffer.hpp
   bool operator==(const RefinementSettings&) const = default;
 };
 

@@ -2,6 +2,7 @@
 
 #include <limits>
 
+#include "core/refinement/buffer.hpp"
 #include "core/refinement/family.hpp"
 
 namespace sph::refine {
@@ -12,7 +13,7 @@ template <int D>
 std::vector<std::size_t> level_counts(const ParticleStore<D>& store) {
   std::vector<std::size_t> per_level;
   for (std::size_t i = 0; i < store.size(); ++i) {
-    if (store.kind[i] != Kind::fluid) continue;
+    if (store.kind[i] != Kind::fluid || is_passive(store.role[i])) continue;  // active fluid only, as diagnostics
     const auto l = static_cast<std::size_t>(std::max(0, store.level[i]));
     if (per_level.size() <= l) per_level.resize(l + 1, 0);
     ++per_level[l];
@@ -80,6 +81,8 @@ bool RefinementStageIn<D>::after_step(SimulationT<D>& sim) {
   // A particle whose daughters' ids would not fit stays whole, and is counted: a split that could not be told
   // apart from its siblings later would break the families and the id order of every cell.
   bool any = false;
+  const bool buffered = settings_.coupling == LevelCoupling::buffered;
+  const std::size_t flips = buffered ? prepare_buffered_marks(store, marks, settings_.max_level) : 0;
   for (std::size_t i = 0; i < store.size(); ++i) {
     if (!(marks[i] && store.kind[i] == Kind::fluid && store.level[i] < settings_.max_level)) continue;
     if (has_room_for_daughters<D>(store.id[i])) {
@@ -91,7 +94,7 @@ bool RefinementStageIn<D>::after_step(SimulationT<D>& sim) {
   }
   if (any) {
     const SplitResult r = split_marked(store, marks, settings_.pattern, settings_.rsp_k, settings_.max_level,
-                                       sim.settings().geometry.walls(), sim.time());
+                                       sim.settings().geometry.walls(), sim.time(), buffered);
     rec.refined = r.refined;
     rec.shifted = r.shifted;
   }
@@ -113,7 +116,7 @@ bool RefinementStageIn<D>::after_step(SimulationT<D>& sim) {
   }
   total_refused_ += rec.refused;
   // Only a split or a merge changes the particles (and asks for a refresh); a pass that refused splits is logged.
-  const bool changed = rec.refined > 0 || rec.merged > 0;
+  const bool changed = rec.refined > 0 || rec.merged > 0 || flips > 0;
   if (!changed && rec.refused == 0) return false;
   total_ += rec.refined;
   total_merged_ += rec.merged;
@@ -126,6 +129,7 @@ template <int D>
 RefinementStageIn<D>& add_refinement_stage(SimulationT<D>& sim, const RefinementSettings& settings) {
   auto stage = std::make_unique<RefinementStageIn<D>>(settings);
   RefinementStageIn<D>& ref = *stage;
+  sim.set_coupling(settings.coupling);
   sim.add_stage(std::move(stage));
   return ref;
 }

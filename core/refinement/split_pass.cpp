@@ -13,11 +13,13 @@ namespace sph::refine {
 
 template <int D>
 SplitResult split_marked(ParticleStore<D>& store, const std::vector<std::uint8_t>& marks, Pattern pattern,
-                         double rsp_k, int max_level, const std::vector<Wall<D>>& walls, double time) {
+                         double rsp_k, int max_level, const std::vector<Wall<D>>& walls, double time,
+                         bool buffered) {
   constexpr unsigned children = kChildren<D>;
   const std::size_t n = store.size();
   auto splits = [&](std::size_t i) {
-    return marks[i] != 0 && store.kind[i] == Kind::fluid && store.level[i] < max_level;
+    return marks[i] != 0 && store.kind[i] == Kind::fluid && store.level[i] < max_level &&
+           (!buffered || store.role[i] == Role::active || (store.role[i] == Role::buffer && marks[i] == 2));
   };
   // Offsets of the daughters, computed on the store as it is (RSP needs the neighbours), indexed by the
   // rank of the split particle.
@@ -48,7 +50,7 @@ SplitResult split_marked(ParticleStore<D>& store, const std::vector<std::uint8_t
       const std::size_t i = split_index[r];
       OffsetsIn<D> o = pattern == Pattern::aap
                       ? axis_aligned_pattern<D>(store.d[i])
-                      : rotated_scaled_pattern(store.d[i], find_reference(store, *query, i), rsp_k);
+                      : rotated_scaled_pattern(store.d[i], find_reference(store, *query, i, buffered), rsp_k);
       shifted[r] = keep_inside_walls(store.x[i], o, walls, daughter_wall_margin(store.d[i])) ? 1 : 0;
       offsets[r] = o;
     });
@@ -60,15 +62,18 @@ SplitResult split_marked(ParticleStore<D>& store, const std::vector<std::uint8_t
       n,
       [&](std::size_t i) -> std::uint32_t {
         if (store.kind[i] == Kind::ghost) return 0;
-        return splits(i) ? children : 1u;
+        return splits(i) ? children + (buffered ? 1u : 0u) : 1u;
       },
       &out_offsets);
   store.gather(src);
   auto s = store.view();
   par::parallel_for(count, [&](std::size_t r) {
     const std::size_t i = split_index[r];  // index before the gather
-    const std::size_t first = out_offsets[i];
+    const std::size_t parent_at = out_offsets[i];
+    const std::size_t first = parent_at + (buffered ? 1 : 0);
     const Vec<D> xi = s.x[first];
+    const bool to_buffer = buffered && marks[i] == 2;
+    if (buffered && s.role[parent_at] != Role::buffer) s.role[parent_at] = to_buffer ? Role::host : Role::shadow;
     // 1 / 2^D is exact, so m / 2^D is m times it (0.25 m in 2D, as the paper's m/4).
     const double m = (1.0 / static_cast<double>(children)) * s.m[first], h = 0.5 * s.h[first], d = 0.5 * s.d[first];
     const std::int32_t level = s.level[first] + 1;
@@ -87,14 +92,15 @@ SplitResult split_marked(ParticleStore<D>& store, const std::vector<std::uint8_t
       // (Integrator::bin_for), as for a merged particle.
       s.stiffness[k] = 1.0;
       s.dt_limit[k] = 0.0;
+      s.role[k] = to_buffer ? Role::buffer : Role::active;
     }
   });
   return result;
 }
 
 template SplitResult split_marked<2>(ParticleStore<2>&, const std::vector<std::uint8_t>&, Pattern, double, int,
-                                     const std::vector<Wall<2>>&, double);
+                                     const std::vector<Wall<2>>&, double, bool);
 template SplitResult split_marked<3>(ParticleStore<3>&, const std::vector<std::uint8_t>&, Pattern, double, int,
-                                     const std::vector<Wall<3>>&, double);
+                                     const std::vector<Wall<3>>&, double, bool);
 
 }  // namespace sph::refine

@@ -22,8 +22,13 @@ struct SplitResult {
 /// `walls`. marks has store.size() entries. Daughter a of the particle with id P gets id daughter_id<D>(P, a)
 /// (core/refinement/family.hpp) and level_time = `time`.
 /// Throws std::length_error when a daughter's generation would not fit in its id (kMaxGenerationsIn<D>).
+/// buffered (LevelCoupling::buffered): the parent stays, right before its daughters. marks[i] == 1 splits an active
+/// particle into active daughters and makes it a shadow; marks[i] == 2 splits an active particle (which becomes a
+/// host) or a buffer particle (which stays one) into buffer daughters (core/refinement/buffer.hpp). RSP takes its
+/// reference among the particle's own level.
 template <int D>
 SplitResult split_marked(ParticleStore<D>& store, const std::vector<std::uint8_t>& marks, Pattern pattern,
-                         double rsp_k, int max_level, const std::vector<Wall<D>>& walls, double time = 0.0);
+                         double rsp_k, int max_level, const std::vector<Wall<D>>& walls, double time = 0.0,
+                         bool buffered = false);
 
 }  // namespace sph::refine

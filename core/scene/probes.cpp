@@ -105,7 +105,8 @@ template <int D>
 double point_pressure(const ParticleStore<D>& store, const Vec<D>& point) {
   double num = 0.0, den = 0.0;
   for (std::size_t i = 0; i < store.size(); ++i) {
-    if (store.kind[i] == Kind::wall || !(store.rho[i] > 0.0)) continue;
+    // Passive particles (buffered coupling) are copies of another level's values, not fluid of their own.
+    if (store.kind[i] == Kind::wall || is_passive(store.role[i]) || !(store.rho[i] > 0.0)) continue;
     const double r = (store.x[i] - point).norm();
     if (r >= 2.0 * store.h[i]) continue;
     const double w = store.m[i] / store.rho[i] * CubicSpline<D>::value(r, store.h[i]);

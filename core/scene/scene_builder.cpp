@@ -2,6 +2,7 @@
 
 #include "core/boundary/wall_particles.hpp"
 #include "core/refinement/refinement_stage.hpp"
+#include "core/scene/scene_error.hpp"
 #include "core/setup.hpp"
 
 #include <stdexcept>
@@ -47,6 +48,14 @@ SimulationT<D> build_simulation(const Scene& scene, const par::Comm* comm) {
                                 std::to_string(dimension(scene)) + "D");
   }
   const SolverSettingsT<D> settings = solver_settings<D>(scene);
+  if (comm != nullptr && comm->distributed() && scene.effects.refinement &&
+      scene.effects.refinement->coupling == LevelCoupling::buffered) {
+    // The passive particles' fit reads fluid and ghosts only, not another rank's halos: across ranks it would
+    // differ from one process.
+    throw SceneError("effects.refinement.coupling",
+                     "\"buffered\" runs in one process only so far (a passive particle's fit does not read halos); "
+                     "run without mpirun, or use \"mixed\"");
+  }
   SimulationT<D> sim(settings);
   ParticleStore<D>& store = sim.store();
   const double g = gravity_magnitude(scene);

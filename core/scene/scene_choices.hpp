@@ -49,6 +49,11 @@ struct Choices<Pattern> {
   static constexpr std::array<Choice<Pattern>, 2> table{{{"aap", Pattern::aap}, {"rsp", Pattern::rsp}}};
 };
 template <>
+struct Choices<LevelCoupling> {
+  static constexpr std::array<Choice<LevelCoupling>, 2> table{
+      {{"mixed", LevelCoupling::mixed}, {"buffered", LevelCoupling::buffered}}};
+};
+template <>
 struct Choices<MergeGroups> {
   static constexpr std::array<Choice<MergeGroups>, 2> table{{{"family", MergeGroups::family}, {"cell", MergeGroups::cell}}};
 };

@@ -194,6 +194,15 @@ void validate_scene(const Scene& s) {
     const Refinement& r = *e.refinement;
     const std::string p = "effects.refinement";
     if (r.criterion == Criterion::zone) valid_rect(r.zone, p + ".zone");
+    if (r.coupling == LevelCoupling::buffered) {
+      // What buffered levels do not handle yet (docs/METHOD.md, "Buffered levels"): passive particles are fitted once
+      // per step for every particle, and a family is never taken back.
+      if (r.coarsening) fail(p + ".coupling", "\"buffered\" does not coarsen yet; remove effects.refinement.coarsening or use \"mixed\"");
+      if (s.time.stepping != TimeStepping::global) {
+        fail(p + ".coupling", "\"buffered\" needs time.stepping \"global\" (passive particles are fitted at every "
+                              "evaluation of every particle); use \"mixed\" for per-level steps");
+      }
+    }
     if (const auto& c = r.coarsening) {
       const std::string q = p + ".coarsening";
       if (r.criterion == Criterion::velocity && !(c->v_threshold > 0.0 && c->v_threshold < r.v_threshold)) {

@@ -1,0 +1,95 @@
+#pragma once
+// Buffered levels (effects.refinement.coupling = "buffered"; docs/METHOD.md, "Buffered levels").
+//
+// With the paper's mixed pairs, a refined zone in still water cannot stay at rest: the symmetric pressure term's
+// zeroth-order error at the jump in spacing leaves 4-99 m/s^2 that no pressure field balances, and the jump's
+// interface energy is negative (docs/METHOD.md, "Still water across a level jump"). With buffered levels no pair
+// mixes levels, so each level's sums are taken on a lattice of its own spacing:
+//   - a split keeps its parent, as a passive `shadow` among its active daughters, so the coarse level's lattice
+//     stays whole inside a refined zone;
+//   - an active particle within a fine particle's support of where the next level is active gets passive `buffer`
+//     daughters (it becomes a `host`), so the fine level's lattice reaches a support beyond its zone;
+//   - a passive particle takes its velocity and density from the active particles of the other levels (and their
+//     ghosts) by a linear moving least-squares fit, and moves with that velocity.
+// Active particles meet only their own level (the pair sweep, core/sweep.hpp). Passive ones are not fluid of their
+// own: the diagnostics, the probes and the output counts leave them out; frames keep them with their role.
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "core/cell_grid.hpp"
+#include "core/equation_of_state.hpp"
+#include "core/kernel.hpp"
+#include "core/particle_store.hpp"
+#include "parallel/parallel_for.hpp"
+
+namespace sph::refine {
+
+/// Where the fit's sources do not span a plane (fewer than D + 1 in general position), or its matrix is this badly
+/// conditioned, the passive particle takes the Shepard mean instead: the fit's coefficients would be noise.
+inline constexpr double kFitMinReciprocalCondition = 1e-6;
+
+/// One passive particle's fit: its density and velocity from the active particles j of other levels within
+/// h_i + h_j, weighted by V_j W(r_ij, h_ij), exact for fields linear in x (also where the sources lie on one
+/// side, as at a buffer band's outer edge or by a wall). Returns false when no source is within reach.
+template <int D, class Neighbours>
+bool fit_passive(const ParticleView<D>& s, std::size_t i, Neighbours&& for_each_neighbour, double& rho, Vec<D>& v) {
+  using Mat = Eigen::Matrix<double, D + 1, D + 1>;
+  Mat M = Mat::Zero();
+  Mat F = Mat::Zero();  // columns: rho, v_0 .. v_{D-1}
+  for_each_neighbour([&](std::size_t j, double r2) {
+    if (s.kind[j] != Kind::fluid && s.kind[j] != Kind::ghost) return;
+    if (is_passive(s.role[j]) || s.level[j] == s.level[i]) return;
+    const double w = CubicSpline<D>::value(std::sqrt(r2), 0.5 * (s.h[i] + s.h[j])) * s.m[j] / s.rho[j];
+    Eigen::Matrix<double, D + 1, 1> P;
+    P(0) = 1.0;
+    P.template tail<D>() = (s.x[j] - s.x[i]) / s.h[i];  // in units of h_i: the matrix's entries of one order
+    M += w * P * P.transpose();
+    F.col(0) += (w * s.rho[j]) * P;
+    for (int k = 0; k < D; ++k) F.col(1 + k) += (w * s.v[j][k]) * P;
+  });
+  if (!(M(0, 0) > 0.0)) return false;
+  Eigen::Matrix<double, 1, D + 1> f;
+  const Eigen::FullPivLU<Mat> lu(M);
+  if (lu.rank() == D + 1 && lu.rcond() > kFitMinReciprocalCondition) {
+    f = lu.solve(F).row(0);
+  } else {
+    f = F.row(0) / M(0, 0);
+  }
+  rho = f(0);
+  for (int k = 0; k < D; ++k) v[k] = f(1 + k);
+  return true;
+}
+
+/// Every passive fluid particle's v, rho (and p, and the half-step copies vh, rhoh) from its fit (fit_passive), on
+/// the grid built for the store as it is. A passive particle with no source in reach keeps its values.
+template <int D>
+void interpolate_passive(const ParticleView<D>& s, const CellGrid<D>& grid, const TaitEquationOfState& eos) {
+  par::parallel_for(s.n, [&](std::size_t i) {
+    if (s.kind[i] != Kind::fluid || !is_passive(s.role[i])) return;
+    double rho = 0.0;
+    Vec<D> v = Vec<D>::Zero();
+    const auto neighbours = [&](auto&& f) { grid.for_each_neighbour(i, s.x, s.h, f); };
+    if (!fit_passive(s, i, neighbours, rho, v)) return;
+    s.rho[i] = rho;
+    s.v[i] = v;
+    s.p[i] = eos.pressure(rho);
+    s.vh[i] = v;
+    s.rhoh[i] = rho;
+  });
+}
+
+/// Turns the criterion's marks (1: refine) into a buffered pass's (split_marked with buffered = true), on the store
+/// between steps (fluid, ghosts dropped or not):
+///   - a marked host becomes a shadow and its buffer daughters active (its zone grew over it): no split;
+///   - a mark on a particle that is passive or already has daughters is dropped;
+///   - an unmarked active or buffer particle of level l < max_level without daughters, within h_l + d_l (a daughter's
+///     support 2 h_{l+1}, plus how far its own daughters sit from it) of an active particle of level l + 1, or within
+///     that plus sqrt(D) d_l / 2 of a particle marked at level l (whose daughters are not there yet), is marked 2
+///     (buffer daughters).
+/// Returns the number of hosts that became shadows. Deterministic: no mark depends on the store's order.
+template <int D>
+std::size_t prepare_buffered_marks(ParticleStore<D>& store, std::vector<std::uint8_t>& marks, int max_level);
+
+}  // namespace sph::refine
