@@ -17,6 +17,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <tuple>
 
 #include "core/cell_grid.hpp"
@@ -123,6 +124,11 @@ class PairSweep {
     // lists of due particles) carries no per-pair bin look-ups, due tests or second sums. In six alternating pairs
     // the 2D pressure sweep at 1e5 took a median 25.5 ms against 31.6 ms in the shared loop (docs/PERFORMANCE.md,
     // 2026-12-03). Where they overlap the loops give the same bits: with bin_cap 0 every weight is 1.
+    // Own level only (buffered levels) runs with one global step only (the scene refuses per-level steps with it).
+    if (act.own_level_only) {
+      if (act.bin_cap > 0 || act.active_bin > 0) throw std::logic_error("PairSweep: own-level pairs with time bins");
+      return sweep<false, false, true>(s, grid, act);
+    }
     if (act.rebin) return sweep<true, true>(s, grid, act);
     if (act.bin_cap > 0 || act.active_bin > 0 || act.due_prefix != nullptr) return sweep<true, false>(s, grid, act);
     return sweep<false, false>(s, grid, act);
@@ -131,9 +137,10 @@ class PairSweep {
  private:
   /// Binned: the pairs' bins, weights and the due particles' lists are read (a step of a per-level run).
   /// Rebin: also the sums by the next step's bins (Activity::rebin). Neither: every particle is due, in bin 0.
-  template <bool Binned, bool Rebin>
+  template <bool Binned, bool Rebin, bool OwnLevel = false>
   SweepLimits sweep(ParticleView<D> s, const CellGrid<D>& grid, const Activity& act) const {
     static_assert(Binned || !Rebin, "a rebin sweep reads the bins");
+    static_assert(!(Binned && OwnLevel), "buffered levels step with one global step");
     using Kernel = CubicSpline<D>;
     constexpr bool has_wall_effects = std::tuple_size_v<WallEffects> > 0;
     const double inf = std::numeric_limits<double>::infinity();
@@ -192,7 +199,9 @@ class PairSweep {
               const double r2 = xij.squaredNorm();
               const double support = hi + s.h[j];
               if (r2 >= support * support || j == i) continue;
-              if (act.own_level_only && s.kind[j] != Kind::wall && s.level[j] != s.level[i]) continue;
+              if constexpr (OwnLevel) {
+                if (s.kind[j] != Kind::wall && s.level[j] != s.level[i]) continue;
+              }
               if (s.kind[j] == Kind::wall && !((!Binned || due) && r2 < wall_reach2)) continue;
               pr.j = j;
               pr.xij = xij;
