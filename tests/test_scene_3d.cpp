@@ -217,3 +217,11 @@ TEST(Runner3D, ResumedRunIsBitwiseIdenticalToTheUninterruptedOne) {
 }
 
 }  // namespace
+
+TEST(Scene3D, BufferedLevelsAreRefusedIn3D) {
+  Json doc = tank_doc();
+  ASSERT_EQ(error_of(doc), "");
+  doc["effects"]["refinement"]["coupling"] = "buffered";
+  EXPECT_EQ(error_of(doc).rfind("scene error: effects.refinement.coupling: \"buffered\" is 2D only so far", 0), 0u)
+      << error_of(doc);
+}

@@ -198,6 +198,10 @@ void validate_scene(const Scene& s) {
       // What buffered levels do not handle yet (docs/METHOD.md, "Buffered levels"): passive particles are fitted once
       // per step for every particle, and a family is never taken back.
       if (r.coarsening) fail(p + ".coupling", "\"buffered\" does not coarsen yet; remove effects.refinement.coarsening or use \"mixed\"");
+      if (dimension(s) == 3) {
+        fail(p + ".coupling", "\"buffered\" is 2D only so far: the 3D still tank with a buffered zone is not yet still "
+                              "(docs/METHOD.md, \"Buffered levels\"); use \"mixed\"");
+      }
       if (s.time.stepping != TimeStepping::global) {
         fail(p + ".coupling", "\"buffered\" needs time.stepping \"global\" (passive particles are fitted at every "
                               "evaluation of every particle); use \"mixed\" for per-level steps");
