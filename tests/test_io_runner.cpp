@@ -143,6 +143,18 @@ TEST(Runner, ResumedRunIsBitwiseIdenticalToTheUninterruptedOne) {
   EXPECT_FALSE(has_temporary_files(c_dir));
 }
 
+/// tiny_scene() refined in the zone [lo, hi] up to max_level, checked every 10 steps.
+scene::Scene tiny_zone_scene(const Vec<2>& lo, const Vec<2>& hi, int max_level) {
+  scene::Scene s = tiny_scene();
+  scene::Refinement r;
+  r.criterion = scene::Criterion::zone;
+  r.zone = scene::Rect{lo, hi};
+  r.check_interval = 10;
+  r.max_level = max_level;
+  s.effects.refinement = r;
+  return s;
+}
+
 /// Runs `s` with a checkpoint every 0.05 s, resumes a copy from the first checkpoint, and expects the resumed run
 /// to end bitwise as the uninterrupted one. `check` looks at the uninterrupted run's end state first.
 template <class Check>
@@ -165,14 +177,9 @@ void expect_resume_is_bitwise(const scene::Scene& s, Check&& check) {
 // The same with coarsening: families split in a zone at the toe of the column and merge as the toe runs out
 // of it; the merge state (level_time, origin) travels in the checkpoint like every field.
 TEST(Runner, ResumedRunWithCoarseningIsBitwiseIdenticalToTheUninterruptedOne) {
-  scene::Scene s = tiny_scene();
-  scene::Refinement r;
-  r.criterion = scene::Criterion::zone;
-  r.zone = scene::Rect{Vec<2>(0.7, 0.0), Vec<2>(1.0, 0.4)};  // the toe of the column, which runs out of it
-  r.check_interval = 10;
-  r.coarsening = scene::Coarsening{};
-  r.coarsening->hold_time = 0.005;
-  s.effects.refinement = r;
+  scene::Scene s = tiny_zone_scene(Vec<2>(0.7, 0.0), Vec<2>(1.0, 0.4), 1);  // the toe, which runs out of the zone
+  s.effects.refinement->coarsening = scene::Coarsening{};
+  s.effects.refinement->coarsening->hold_time = 0.005;
   s.time.end = 0.15;
   expect_resume_is_bitwise(s, [](const ParticleStore<2>& st) {
     std::size_t merged = 0;
@@ -186,13 +193,7 @@ TEST(Runner, ResumedRunWithCoarseningIsBitwiseIdenticalToTheUninterruptedOne) {
 // checkpoint is written between steps, where every bin is synchronised, and holds the rates (a, drho, kick) the
 // next step opens with.
 TEST(Runner, ResumedRunWithPerLevelStepsIsBitwiseIdenticalToTheUninterruptedOne) {
-  scene::Scene s = tiny_scene();
-  scene::Refinement r;
-  r.criterion = scene::Criterion::zone;
-  r.zone = scene::Rect{Vec<2>(0.5, 0.0), Vec<2>(1.0, 0.4)};
-  r.check_interval = 10;
-  r.max_level = 2;
-  s.effects.refinement = r;
+  scene::Scene s = tiny_zone_scene(Vec<2>(0.5, 0.0), Vec<2>(1.0, 0.4), 2);
   s.time.stepping = TimeStepping::per_level;
   s.time.end = test::short_runs() ? 0.1 : 0.15;  // shorter under the sanitizer preset (the checkpoint is at 0.05)
   expect_resume_is_bitwise(s, [](const ParticleStore<2>& st) {
@@ -205,14 +206,8 @@ TEST(Runner, ResumedRunWithPerLevelStepsIsBitwiseIdenticalToTheUninterruptedOne)
 // The same with buffered levels (effects.refinement.coupling = "buffered") and two levels in a zone: the roles and the
 // passive particles' fitted state travel in the checkpoint, and the resumed run fits them as the uninterrupted one.
 TEST(Runner, ResumedRunWithBufferedLevelsIsBitwiseIdenticalToTheUninterruptedOne) {
-  scene::Scene s = tiny_scene();
-  scene::Refinement r;
-  r.criterion = scene::Criterion::zone;
-  r.zone = scene::Rect{Vec<2>(0.0, 0.0), Vec<2>(0.3, 0.3)};
-  r.check_interval = 10;
-  r.max_level = 2;
-  r.coupling = LevelCoupling::buffered;
-  s.effects.refinement = r;
+  scene::Scene s = tiny_zone_scene(Vec<2>(0.0, 0.0), Vec<2>(0.3, 0.3), 2);
+  s.effects.refinement->coupling = LevelCoupling::buffered;
   s.time.end = test::short_runs() ? 0.1 : 0.15;
   expect_resume_is_bitwise(s, [](const ParticleStore<2>& st) {
     std::size_t passive = 0;
