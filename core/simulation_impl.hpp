@@ -471,7 +471,8 @@ StepInfo SimulationT<D>::step(double dt_cap) {
         build_neighbours(hr);
       }
       if (choose) rebin = choose_bins_on_grid();
-      // Buffered levels: the passive particles take the active ones' state as predicted for this evaluation.
+      // Buffered levels: the passive particles take the active ones' state as predicted for this evaluation, which is
+      // also the state they end the step with (output, the next drift).
       if (buffered()) refine::interpolate_passive(store_.view(), grid_, settings_.eos);
       Activity act = activity(k, finest);
       act.rebin = rebin;
@@ -501,8 +502,6 @@ StepInfo SimulationT<D>::step(double dt_cap) {
       if (!is_passive(s.role[i])) integ.kick(s, i, dt, true);
       s.bin[i] = s.next_bin[i];
     });
-    // ... and again after the closing kick, from the state the step ends with (output, the next drift).
-    if (buffered()) refine::interpolate_passive(store_.view(), grid_, settings_.eos);
     limits_ = step_limits;
     count_work(finest, step_limits);
   }

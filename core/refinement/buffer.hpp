@@ -51,9 +51,12 @@ bool fit_passive(const ParticleView<D>& s, std::size_t i, Neighbours&& for_each_
   });
   if (!(M(0, 0) > 0.0)) return false;
   Eigen::Matrix<double, 1, D + 1> f;
-  const Eigen::FullPivLU<Mat> lu(M);
-  if (lu.rank() == D + 1 && lu.rcond() > kFitMinReciprocalCondition) {
-    f = lu.solve(F).row(0);
+  // M is symmetric and positive semi-definite: a Cholesky factorisation (LDL^T, pivoted), with its diagonal as the
+  // conditioning test (the ratio of the smallest to the largest pivot bounds the reciprocal condition from above).
+  const Eigen::LDLT<Mat> ldlt(M);
+  const auto pivots = ldlt.vectorD();
+  if (ldlt.info() == Eigen::Success && pivots.minCoeff() > kFitMinReciprocalCondition * pivots.maxCoeff()) {
+    f = ldlt.solve(F).row(0);
   } else {
     f = F.row(0) / M(0, 0);
   }
@@ -63,7 +66,9 @@ bool fit_passive(const ParticleView<D>& s, std::size_t i, Neighbours&& for_each_
 }
 
 /// Every passive fluid particle's v, rho (and p, and the half-step copies vh, rhoh) from its fit (fit_passive), on
-/// the grid built for the store as it is. A passive particle with no source in reach keeps its values.
+/// the grid built for the store as it is: once before each evaluation (Simulation::step, Simulation::refresh), so
+/// the active particles meet the other levels' state as predicted for it. A passive particle with no source in reach
+/// keeps its values.
 template <int D>
 void interpolate_passive(const ParticleView<D>& s, const CellGrid<D>& grid, const TaitEquationOfState& eos) {
   par::parallel_for(s.n, [&](std::size_t i) {
