@@ -569,6 +569,7 @@ TEST(SceneParser, MissingFileIsASceneError) {
 
 TEST(SceneParser, BufferedCouplingIsRefusedWhereItIsNotBuiltYet) {
   Json doc = full_scene();
+  doc["fluid"][1]["level"] = 0;  // one starting level: with buffered levels, levels meet only through splits
   doc["effects"]["refinement"]["coupling"] = "buffered";
   ASSERT_EQ(error_of(doc), "");
   const Scene s = scene_from_json(doc);
@@ -586,6 +587,15 @@ TEST(SceneParser, BufferedCouplingIsRefusedWhereItIsNotBuiltYet) {
   EXPECT_EQ(error_of(velocity).rfind("scene error: effects.refinement.coupling: unknown key; allowed for criterion velocity", 0),
             0u)
       << error_of(velocity);
+  Json two_levels = doc;
+  two_levels["fluid"][1]["level"] = 1;
+  EXPECT_EQ(error_of(two_levels).rfind(refused + "needs every fluid region at one starting level", 0), 0u)
+      << error_of(two_levels);
+  Json with_static = doc;
+  with_static["effects"]["static_refinement"] = Json::object();
+  with_static["effects"]["refinement"]["max_level"] = 3;
+  EXPECT_EQ(error_of(with_static).rfind(refused + "cannot follow effects.static_refinement", 0), 0u)
+      << error_of(with_static);
   doc["effects"]["refinement"]["coupling"] = "apr";
   EXPECT_EQ(error_of(doc), "scene error: effects.refinement.coupling: must be one of: mixed, buffered (got 'apr')");
 }

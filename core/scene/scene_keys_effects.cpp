@@ -160,8 +160,8 @@ const S<Refinement>& refinement_section() {
               .means("families merge back where the flow no longer needs them"));
     d.add(value<Refinement>("coupling", member(&Refinement::coupling))
               .only_for({"zone"})
-              .note("`buffered`: 2D, one process, `time.stepping` global, no coarsening; fluid that leaves the zone is not "
-                    "handed back yet")
+              .note("`buffered`: 2D, one process, `time.stepping` global, no coarsening or static refinement, every fluid "
+                    "region at one level; fluid that leaves the zone is not handed back yet")
               .means("how levels interact: every pair (`mixed`, the paper's), or each level with its own, its lattice "
                      "completed by passive particles fitted to the other levels (`buffered`, docs/METHOD.md)"));
     return d;

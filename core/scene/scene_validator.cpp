@@ -206,6 +206,16 @@ void validate_scene(const Scene& s) {
         fail(p + ".coupling", "\"buffered\" needs time.stepping \"global\" (passive particles are fitted at every "
                               "evaluation of every particle); use \"mixed\" for per-level steps");
       }
+      // No pair mixes levels, so particles of different levels that no split made (a static refinement, fluid regions
+      // set up at other levels) would not meet at all: they have no shadows or buffer particles between them.
+      if (e.static_refinement) fail(p + ".coupling", "\"buffered\" cannot follow effects.static_refinement (its splits leave no shadows); use \"mixed\"");
+      for (std::size_t k = 1; k < s.fluid.size(); ++k) {
+        if (s.fluid[k].level != s.fluid[0].level) {
+          fail(p + ".coupling", "\"buffered\" needs every fluid region at one starting level (" + element("fluid", k) +
+                                    " is at level " + std::to_string(s.fluid[k].level) + ", fluid[0] at " +
+                                    std::to_string(s.fluid[0].level) + "): levels meet only through splits");
+        }
+      }
     }
     if (const auto& c = r.coarsening) {
       const std::string q = p + ".coarsening";
