@@ -262,6 +262,13 @@ class Integrator {
   }
 
   /// Kick after the evaluation of substep k: full (closing and opening) inside the step, closing at its end.
+  /// A passive particle (buffered levels, core/refinement/buffer.hpp) is neither kicked nor predicted: over a substep
+  /// of length tau it moves with the velocity of its last fit.
+  template <int D>
+  void carry(const ParticleView<D>& s, std::size_t i, double tau) const {
+    s.x[i] += tau * s.v[i];
+  }
+
   template <int D>
   void kick(const ParticleView<D>& s, std::size_t i, double dt0, bool closing) const {
     if (closing) {

@@ -433,7 +433,7 @@ StepInfo SimulationT<D>::step(double dt_cap) {
           [&](SmoothingRange& r, std::size_t i) {
             if (k == 1 && watch) last_good_.copy_particle(store_, i);
             if (s.kind[i] == Kind::fluid && is_passive(s.role[i])) {
-              s.x[i] += tau * s.v[i];  // buffered levels: a passive particle moves with its fitted velocity
+              integ.carry(s, i, tau);
             } else if (s.kind[i] == Kind::fluid) {
               if (k == 1) {
                 integ.open(s, i, dt);

@@ -11,63 +11,21 @@
 
 #include "core/scene/scene_keys.hpp"
 #include "core/scene/scene_parser.hpp"
+#include "tests/support/scene_documents.hpp"
 
 namespace {
 
 using namespace sph::scene;
+using sph::test::error_of;
+using sph::test::full_scene;
 
 const std::filesystem::path kCases = std::filesystem::path(__FILE__).parent_path().parent_path() / "cases";
-
-/// A small valid scene exercising every section; tests break one thing at a time.
-Json full_scene() {
-  return parse_json_text(R"({
-    "name": "full",
-    "description": "every key",
-    "container": { "lo": [0, 0], "hi": [20, 10], "open_top": false },
-    "obstacles": [ { "lo": [14, 0], "hi": [15, 3] } ],
-    "fluid": [
-      { "shape": "rectangle", "lo": [0, 0], "hi": [5, 5], "spacing": 0.5, "hydrostatic": true, "surface": 5 },
-      { "shape": "circle", "centre": [8, 7], "radius": 1.0, "spacing": 0.5, "level": 1, "velocity": [0, -1] }
-    ],
-    "h_factor": 1.3,
-    "material": { "rho0": 1000, "gamma": 7, "mach_factor": 10, "reference_height": 5 },
-    "effects": {
-      "gravity": [0, -9.81],
-      "artificial_viscosity": { "alpha": 0.05, "beta": 0.1 },
-      "artificial_stress": { "epsilon": 0.3, "exponent": 3 },
-      "density_diffusion": { "delta": 0.12 },
-      "lennard_jones_wall": { "reference_height": 5, "r0_factor": 0.5 },
-      "ghost_walls": "no-slip",
-      "refinement": { "criterion": "zone", "zone": { "lo": [0, 0], "hi": [3, 3] }, "pattern": "rsp", "rsp_k": 0.5,
-                      "check_interval": 10, "max_level": 2 }
-    },
-    "time": { "end": 1.5, "cfl": 0.25, "output_interval": 0.1, "dt_max": 0.01 },
-    "probes": [
-      { "type": "water_height", "name": "H", "x": 0, "band": 0.6 },
-      { "type": "surge_front", "origin": 0 },
-      { "type": "surface_elevation", "name": "eta", "x": 10, "datum": 5 },
-      { "type": "pressure", "name": "p", "position": [1, 1] }
-    ],
-    "output": { "folder": "out/full", "frames": true, "frame_interval": 0.5, "fields": ["position", "velocity"] }
-  })",
-                         "full_scene");
-}
 
 std::string detail_num(double x) {
   std::ostringstream s;
   s.precision(6);
   s << x;
   return s.str();
-}
-
-/// The SceneError a document raises ("" when it is accepted).
-std::string error_of(const Json& doc) {
-  try {
-    (void)scene_from_json(doc);
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  return "";
 }
 
 TEST(SceneParser, FullSceneParsesWithEveryValue) {
@@ -566,36 +524,3 @@ TEST(SceneParser, MissingFileIsASceneError) {
 }
 
 }  // namespace
-
-TEST(SceneParser, BufferedCouplingIsRefusedWhereItIsNotBuiltYet) {
-  Json doc = full_scene();
-  doc["fluid"][1]["level"] = 0;  // one starting level: with buffered levels, levels meet only through splits
-  doc["effects"]["refinement"]["coupling"] = "buffered";
-  ASSERT_EQ(error_of(doc), "");
-  const Scene s = scene_from_json(doc);
-  EXPECT_EQ(s.effects.refinement->coupling, sph::LevelCoupling::buffered);
-  EXPECT_EQ(scene_from_json(scene_to_json(s)), s);
-  const std::string refused = "scene error: effects.refinement.coupling: \"buffered\" ";
-  Json coarsening = doc;
-  coarsening["effects"]["refinement"]["coarsening"] = Json::object();
-  EXPECT_EQ(error_of(coarsening).rfind(refused + "does not coarsen yet", 0), 0u) << error_of(coarsening);
-  Json per_level = doc;
-  per_level["time"]["stepping"] = "per_level";
-  EXPECT_EQ(error_of(per_level).rfind(refused + "needs time.stepping \"global\"", 0), 0u) << error_of(per_level);
-  Json velocity = doc;
-  velocity["effects"]["refinement"] = Json{{"v_threshold", 5}, {"coupling", "buffered"}};
-  EXPECT_EQ(error_of(velocity).rfind("scene error: effects.refinement.coupling: unknown key; allowed for criterion velocity", 0),
-            0u)
-      << error_of(velocity);
-  Json two_levels = doc;
-  two_levels["fluid"][1]["level"] = 1;
-  EXPECT_EQ(error_of(two_levels).rfind(refused + "needs every fluid region at one starting level", 0), 0u)
-      << error_of(two_levels);
-  Json with_static = doc;
-  with_static["effects"]["static_refinement"] = Json::object();
-  with_static["effects"]["refinement"]["max_level"] = 3;
-  EXPECT_EQ(error_of(with_static).rfind(refused + "cannot follow effects.static_refinement", 0), 0u)
-      << error_of(with_static);
-  doc["effects"]["refinement"]["coupling"] = "apr";
-  EXPECT_EQ(error_of(doc), "scene error: effects.refinement.coupling: must be one of: mixed, buffered (got 'apr')");
-}

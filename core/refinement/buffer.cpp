@@ -2,9 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <array>
 #include <cstdint>
-#include <unordered_map>
 #include <unordered_set>
 
 #include "core/refinement/family.hpp"
@@ -13,49 +11,33 @@ namespace sph::refine {
 
 namespace {
 
-/// Points hashed into cubic cells of edge `edge`: near(x, reach) is true when a point lies within reach <= edge of x.
+/// Points sorted into the project's cell grid (one layer, cells of edge `edge`): near(x, reach) is true when a point
+/// lies within reach <= edge of x.
 template <int D>
-class PointCells {
+class Points {
  public:
-  explicit PointCells(double edge) : edge_(edge) {}
-  void add(const Vec<D>& x) { cells_[key(cell(x))].push_back(x); }
-  bool empty() const { return cells_.empty(); }
+  void add(const Vec<D>& x) { x_.push_back(x); }
+  bool empty() const { return x_.empty(); }
+  void sort(double edge) {
+    if (x_.empty()) return;
+    // A query around p with "smoothing length" h reaches h + max_h: max_h = edge / 2, and near() asks h = reach - max_h.
+    grid_.build(x_.data(), x_.size(), edge, 0.5 * edge);
+    half_edge_ = 0.5 * edge;
+  }
   bool near(const Vec<D>& x, double reach) const {
-    const std::array<std::int64_t, D> c = cell(x);
-    constexpr int kAround = D == 2 ? 9 : 27;
-    for (int k = 0; k < kAround; ++k) {
-      std::array<std::int64_t, D> b = c;
-      int rest = k;
-      for (int a = 0; a < D; ++a) {
-        b[static_cast<std::size_t>(a)] += rest % 3 - 1;
-        rest /= 3;
-      }
-      const auto it = cells_.find(key(b));
-      if (it == cells_.end()) continue;
-      for (const Vec<D>& y : it->second) {
-        if ((y - x).squaredNorm() < reach * reach) return true;
-      }
-    }
-    return false;
+    if (x_.empty()) return false;
+    bool found = false;
+    const auto& order = grid_.order();
+    grid_.for_each_support_run(x, reach - half_edge_, [&](std::uint32_t b, std::uint32_t e) {
+      for (std::uint32_t k = b; k < e && !found; ++k) found = (x_[order[k]] - x).squaredNorm() < reach * reach;
+    });
+    return found;
   }
 
  private:
-  std::array<std::int64_t, D> cell(const Vec<D>& x) const {
-    std::array<std::int64_t, D> c{};
-    for (int a = 0; a < D; ++a) c[static_cast<std::size_t>(a)] = static_cast<std::int64_t>(std::floor(x[a] / edge_));
-    return c;
-  }
-  static std::uint64_t key(const std::array<std::int64_t, D>& c) {
-    std::uint64_t k = 1469598103934665603ull;  // FNV-1a over the coordinates
-    for (const std::int64_t v : c) {
-      k ^= static_cast<std::uint64_t>(v);
-      k *= 1099511628211ull;
-    }
-    return k;
-  }
-  double edge_;
-  // Cells that hash alike share a list; near() tests distances, so that only costs time.
-  std::unordered_map<std::uint64_t, std::vector<Vec<D>>> cells_;
+  std::vector<Vec<D>> x_;
+  CellGrid<D> grid_;
+  double half_edge_ = 0.0;
 };
 
 }  // namespace
@@ -97,13 +79,15 @@ std::size_t prepare_buffered_marks(ParticleStore<D>& store, std::vector<std::uin
       if (fluid(i) && store.level[i] == l) reach = std::max(reach, (1.0 + half_diagonal) * store.d[i] + store.h[i]);
     }
     if (!(reach > 0.0)) continue;
-    PointCells<D> active(reach), marked(reach);
+    Points<D> active, marked;
     for (std::size_t i = 0; i < n; ++i) {
       if (!fluid(i)) continue;
       if (store.level[i] == l + 1 && !is_passive(store.role[i])) active.add(store.x[i]);
       if (store.level[i] == l && marks[i] == 1) marked.add(store.x[i]);
     }
     if (active.empty() && marked.empty()) continue;
+    active.sort(reach);
+    marked.sort(reach);
     for (std::size_t i = 0; i < n; ++i) {
       if (!fluid(i) || store.level[i] != l || marks[i] != 0) continue;
       if (!(store.role[i] == Role::active || store.role[i] == Role::buffer) || parents.count(store.id[i]) != 0) continue;

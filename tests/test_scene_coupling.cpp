@@ -1,0 +1,49 @@
+// effects.refinement.coupling in scene files: "buffered" is accepted where buffered levels are built, round-trips,
+// and is refused with a message naming the key where they are not (core/scene/scene_validator.cpp).
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "core/scene/scene_parser.hpp"
+#include "tests/support/scene_documents.hpp"
+
+namespace {
+
+using namespace sph::scene;
+using sph::test::error_of;
+using sph::test::full_scene;
+
+TEST(SceneCoupling, BufferedIsRefusedWhereItIsNotBuiltYet) {
+  Json doc = full_scene();
+  doc["fluid"][1]["level"] = 0;  // one starting level: with buffered levels, levels meet only through splits
+  doc["effects"]["refinement"]["coupling"] = "buffered";
+  ASSERT_EQ(error_of(doc), "");
+  const Scene s = scene_from_json(doc);
+  EXPECT_EQ(s.effects.refinement->coupling, sph::LevelCoupling::buffered);
+  EXPECT_EQ(scene_from_json(scene_to_json(s)), s);
+  const std::string refused = "scene error: effects.refinement.coupling: \"buffered\" ";
+  Json coarsening = doc;
+  coarsening["effects"]["refinement"]["coarsening"] = Json::object();
+  EXPECT_EQ(error_of(coarsening).rfind(refused + "does not coarsen yet", 0), 0u) << error_of(coarsening);
+  Json per_level = doc;
+  per_level["time"]["stepping"] = "per_level";
+  EXPECT_EQ(error_of(per_level).rfind(refused + "needs time.stepping \"global\"", 0), 0u) << error_of(per_level);
+  Json velocity = doc;
+  velocity["effects"]["refinement"] = Json{{"v_threshold", 5}, {"coupling", "buffered"}};
+  EXPECT_EQ(error_of(velocity).rfind("scene error: effects.refinement.coupling: unknown key; allowed for criterion velocity", 0),
+            0u)
+      << error_of(velocity);
+  Json two_levels = doc;
+  two_levels["fluid"][1]["level"] = 1;
+  EXPECT_EQ(error_of(two_levels).rfind(refused + "needs every fluid region at one starting level", 0), 0u)
+      << error_of(two_levels);
+  Json with_static = doc;
+  with_static["effects"]["static_refinement"] = Json::object();
+  with_static["effects"]["refinement"]["max_level"] = 3;
+  EXPECT_EQ(error_of(with_static).rfind(refused + "cannot follow effects.static_refinement", 0), 0u)
+      << error_of(with_static);
+  doc["effects"]["refinement"]["coupling"] = "apr";
+  EXPECT_EQ(error_of(doc), "scene error: effects.refinement.coupling: must be one of: mixed, buffered (got 'apr')");
+}
+
+}  // namespace
