@@ -17,7 +17,8 @@ pass and at the end. Figures:
     carried to the layer's middle along the hydrostatic gradient, averaged over the layer and the window's frames; the table gives the largest |p - p_unrefined| / p_unrefined over the
     layers below 9 m (the top layer's pressure is near zero, so a relative error means nothing there), and
     the same normalised by rho g H at the floor;
-  - creep: the fluid count at the first output after the first pass (t >= 1 s) and at the end.
+  - creep: the fluid count at the first output after the first pass (t >= 1 s) and at the end;
+  - energy: the kinetic energy averaged over the window, and the total energy's change from 1 s to the end.
 The environment variable SPH_APP names another sphrefine binary (to compare a build with a candidate change).
 Exit status 0 when every run completed; 1 when one failed.
 """
@@ -112,6 +113,10 @@ def summarize(out, end):
         "fluid_end": int(s["fluid"][-1]),
         "removed": int(s["removed"][-1]) if "removed" in s else 0,
         "layers": layer_pressure(out, end / 3.0),
+        # The active fluid's kinetic energy, averaged over the window, and the total energy's change from 1 s (after
+        # the first pass) to the end: whether the motion carries energy, and whether anything feeds it.
+        "kmean": float(np.mean(s["kinetic"][window])) if window.any() else float("nan"),
+        "de": float(s["total_energy"][-1] - s["total_energy"][after[0]]) if len(after) else float("nan"),
     }
 
 
@@ -139,8 +144,8 @@ def main():
           + f"; coupling {args.coupling}"
           + (f"; every run with {' '.join(args.extra)}" if args.extra else "") + "\n")
     print("| run | status | max |v| (m/s) | mean max |v| in window | / unrefined | layer p err (max, < 9 m) "
-          "| / rho g H | fluid after 1st pass -> end |")
-    print("|---|---|---|---|---|---|---|---|")
+          "| / rho g H | fluid after 1st pass -> end | kinetic, window mean (J/m) | total energy, 1 s -> end (J/m) |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     ok = True
     for name, _ in jobs:
         r = res[name]
@@ -149,7 +154,8 @@ def main():
         absn = np.abs(r["layers"][:9] - base["layers"][:9]) / (RHO0 * G * DEPTH)
         status = r["status"] if r["status"] == "completed" else f"{r['status']} at {r['ended']:.2f} s"
         print(f"| {name} | {status} | {r['vmax']:.3g} | {r['vmean']:.3g} | {r['vmean'] / base['vmean']:.3g} "
-              f"| {100 * rel.max():.2f} % | {100 * absn.max():.2f} % | {r['fluid_first']} -> {r['fluid_end']} |")
+              f"| {100 * rel.max():.2f} % | {100 * absn.max():.2f} % | {r['fluid_first']} -> {r['fluid_end']} "
+              f"| {r['kmean']:.3g} | {r['de']:+.3g} |")
     return 0 if ok else 1
 
 
