@@ -28,6 +28,9 @@ struct TaitEquationOfState {
     return B() * (std::pow(r, gamma) - 1.0);
   }
 
+  /// dp/drho = c0^2 (rho / rho0)^(gamma - 1): the local sound speed squared.
+  double sound_speed_squared(double rho) const { return c0 * c0 * std::pow(rho / rho0, gamma - 1.0); }
+
   /// Inverse: the density at pressure p (hydrostatic initial state).
   double density(double p) const { return rho0 * std::pow(1.0 + p / B(), 1.0 / gamma); }
 

@@ -43,6 +43,7 @@ struct ParticleView {
   Vec<D>* jerk = nullptr;
   double* density_jerk = nullptr;
   Role* role = nullptr;
+  Vec<D>* tie = nullptr;
 };
 
 template <int D>
@@ -91,6 +92,9 @@ class ParticleStore {
   Field<VecD> jerk{"jerk", "m/s^3"};
   Field<double> density_jerk{"density_jerk", "kg/m^3/s^2"};
   Field<Role> role{"role", "1"};  // core/types.hpp
+  // A daughter's place relative to its parent when it took it (its split, or a handover that kept it as a buffer). A
+  // buffer particle (buffered coupling) keeps that place: it moves with its host (core/refinement/buffer.hpp).
+  Field<VecD> tie{"tie_offset", "m"};
 
   /// The registry: every field as a pointer to member. Adding a field above and here is all it takes for
   /// every operation (gather, compaction, expansion, copies, output, checkpoints) to carry it.
@@ -102,7 +106,7 @@ class ParticleStore {
                            &ParticleStore::origin, &ParticleStore::kick, &ParticleStore::kick_rho,
                            &ParticleStore::bin, &ParticleStore::next_bin, &ParticleStore::stiffness,
                            &ParticleStore::dt_limit, &ParticleStore::jerk, &ParticleStore::density_jerk,
-                           &ParticleStore::role);
+                           &ParticleStore::role, &ParticleStore::tie);
   }
 
   /// Visits every field. f is called with each Field<T>&.
@@ -209,7 +213,7 @@ class ParticleStore {
     return {size(), x.data(), v.data(), rho.data(), p.data(), m.data(), h.data(), d.data(),
             level.data(), kind.data(), id.data(), drho.data(), a.data(), vh.data(), rhoh.data(), level_time.data(),
             origin.data(), kick.data(), kick_rho.data(), bin.data(), next_bin.data(), stiffness.data(), dt_limit.data(),
-            jerk.data(), density_jerk.data(), role.data()};
+            jerk.data(), density_jerk.data(), role.data(), tie.data()};
   }
 
   /// Bytes held by every field (data and scratch), for memory reports.
@@ -221,7 +225,7 @@ class ParticleStore {
 
   /// Bytes one particle occupies across all fields.
   static constexpr std::size_t bytes_per_particle() {
-    return 6 * sizeof(VecD) + 12 * sizeof(double) + 3 * sizeof(std::int32_t) + sizeof(Kind) + sizeof(ParticleId) +
+    return 7 * sizeof(VecD) + 12 * sizeof(double) + 3 * sizeof(std::int32_t) + sizeof(Kind) + sizeof(ParticleId) +
            sizeof(Origin) + sizeof(Role);
   }
 

@@ -447,6 +447,7 @@ StepInfo SimulationT<D>::step(double dt_cap) {
           },
           [](const SmoothingRange& a, const SmoothingRange& b) { return a.merged(b); });
     }
+    if (buffered()) refine::tie_buffers(store_);
     // Fluid that left through an open top (container.outflow = "remove") goes now, before the neighbour search
     // and the watchdog. A removal renumbers the particles, so the counts and range of the loop above are redone.
     bool renumbered = false;

@@ -257,8 +257,56 @@ TEST_P(BufferedStillTank, StaysAsStillAsTheUnrefinedTank) {
 INSTANTIATE_TEST_SUITE_P(Zones, BufferedStillTank,
                          ::testing::Values(TankCase{"bulk_aap_1", Vec<2>(10, 3), Vec<2>(15, 7), refine::Pattern::aap, 1},
                                            TankCase{"wall_rsp_1", Vec<2>(0, 3), Vec<2>(4, 7), refine::Pattern::rsp, 1},
+                                           TankCase{"wall_rsp_2", Vec<2>(0, 3), Vec<2>(4, 7), refine::Pattern::rsp, 2},
                                            TankCase{"corner_rsp_2", Vec<2>(0, 0), Vec<2>(5, 4), refine::Pattern::rsp, 2}),
                          [](const auto& p) { return std::string(p.param.name); });
+
+/// tie_buffers against the brute force: after the hosts move (each by its own displacement), every buffer particle
+/// sits at its host's place plus its tie, the host found by a scan of the whole store, level by level, so that a
+/// buffer particle whose host is a buffer particle follows it.
+TEST(BufferedLevels, BufferParticlesFollowTheirHostsAsTheBruteForcePlacesThem) {
+  refine::RefinementSettings r;
+  r.criterion = refine::CriterionKind::zone;
+  r.zone = Box2{Vec<2>(0, 3), Vec<2>(4, 7)};
+  r.check_interval = 50;
+  r.max_level = 2;
+  r.coupling = LevelCoupling::buffered;
+  Simulation sim = make_still_tank(TankSpec{});
+  refine::add_refinement_stage(sim, r);
+  for (int k = 0; k < 120; ++k) {
+    sim.step();
+    sim.run_stages();
+  }
+  ParticleStore<2> s = sim.store();
+  std::size_t nested = 0, buffers = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] != Kind::fluid) continue;
+    if (s.role[i] == Role::host || s.role[i] == Role::buffer) {  // displaced: none is where its buffers were put
+      s.x[i] += Vec<2>(1e-3 * static_cast<double>(1 + i % 7), -2e-3 * static_cast<double>(1 + i % 5));
+    }
+    if (s.role[i] == Role::buffer) ++buffers;
+    if (s.role[i] == Role::buffer && s.level[i] == 2) ++nested;
+  }
+  ASSERT_GT(nested, 20u) << "level-2 buffer particles, hosted by level-1 buffer particles";
+  ParticleStore<2> expected = s;
+  for (int l = 1; l <= 2; ++l) {
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      if (expected.kind[i] != Kind::fluid || expected.role[i] != Role::buffer || expected.level[i] != l) continue;
+      for (std::size_t j = 0; j < s.size(); ++j) {
+        if (expected.kind[j] == Kind::fluid && expected.id[j] == refine::parent_id(expected.id[i])) {
+          expected.x[i] = expected.x[j] + expected.tie[i];
+        }
+      }
+    }
+  }
+  refine::tie_buffers(s);
+  std::size_t moved = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    EXPECT_EQ(s.x[i], expected.x[i]) << i;
+    moved += s.role[i] == Role::buffer && s.x[i] != sim.store().x[i] ? 1 : 0;
+  }
+  EXPECT_EQ(moved, buffers);
+}
 
 /// The same bits at one and two threads: the flips, the band and the fit do not depend on the threads' shares.
 TEST(BufferedLevels, StillTankIsBitwiseTheSameAtOneAndTwoThreads) {

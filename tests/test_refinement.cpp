@@ -106,7 +106,7 @@ TEST(Refinement, DaughtersGetQuarterMassHalfSmoothingLengthParentVelocityAndDens
   ParticleStore<2> s = random_cloud(50, 3);
   const ParticleStore<2> old = s;
   std::vector<std::uint8_t> marks(s.size(), 0);
-  marks[10] = 1;
+  marks.at(10) = 1;
   refine::split_marked(s, marks, Pattern::aap, 1.0, 5, {});
   ASSERT_EQ(s.size(), 53u);
   for (std::size_t a = 10; a < 14; ++a) {
@@ -125,6 +125,54 @@ TEST(Refinement, DaughtersGetQuarterMassHalfSmoothingLengthParentVelocityAndDens
   EXPECT_EQ(std::adjacent_find(ids.begin(), ids.end()), ids.end());
   EXPECT_EQ(s.id[9], old.id[9]);
   EXPECT_EQ(s.id[14], old.id[11]);
+}
+
+// effects.refinement.daughter_density = "pressure_gradient" (core/refinement/split_pass.hpp). At rest (a = 0) the
+// daughters' pressures differ as the hydrostatic field does between their heights, rho g . (x_a - x_b): the density is
+// carried along grad rho = rho g / c^2, so the difference is exact but for the equation of state's curvature: the
+// Taylor terms p2 (delta_a^2 - delta_b^2) / 2 + p3 (delta_a^3 - delta_b^3) / 6, delta being the change of density and
+// p2 = (gamma - 1) c^2 / rho, p3 = (gamma - 1)(gamma - 2) c^2 / rho^2 the second and third derivatives of p(rho). The
+// bound is their sum with a tenth more for the next terms (each smaller by |delta| gamma / rho < 1e-3), plus rounding. The family's mean density is the parent's (the offsets sum to zero), and a parent in free fall (a = g:
+// no pressure gradient) gives every daughter its own density.
+TEST(Refinement, PressureGradientDaughtersCarryTheParentsDensityAlongItsPressureGradient) {
+  const TaitEquationOfState eos{1000.0, 99.0, 7.0};
+  const Vec<2> g(0.0, -9.81);
+  const refine::DaughterDensityIn<2> rule{refine::DaughterDensity::pressure_gradient, g, eos};
+  for (const Pattern pattern : {Pattern::aap, Pattern::rsp}) {
+    ParticleStore<2> s = random_cloud(50, 3);
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      s.a[i] = Vec<2>::Zero();
+      s.p[i] = eos.pressure(s.rho[i]);
+    }
+    s.a[20] = g;  // in free fall
+    const ParticleStore<2> old = s;
+    std::vector<std::uint8_t> marks(s.size(), 0);
+    marks[10] = marks[20] = 1;
+    refine::split_marked(s, marks, pattern, 1.0, 5, {}, 0.0, false, rule);
+    ASSERT_EQ(s.size(), 56u);
+    const double rho = old.rho[10];
+    double mean = 0.0, highest = 0.0;
+    for (std::size_t a = 10; a < 14; ++a) {
+      mean += 0.25 * s.rho[a];
+      EXPECT_EQ(s.p[a], eos.pressure(s.rho[a]));
+      for (std::size_t b = 10; b < 14; ++b) {
+        const double da = s.rho[a] - rho, db = s.rho[b] - rho;
+        const double c2 = eos.sound_speed_squared(rho), n = eos.gamma - 1.0;
+        const double curvature = 0.5 * n * c2 / rho * std::abs(da * da - db * db) +
+                                 n * (n - 1.0) * c2 / (6.0 * rho * rho) * std::abs(da * da * da - db * db * db);
+        const double hydrostatic = rho * g.dot(s.x[a] - s.x[b]);
+        highest = std::max(highest, s.x[a][1] - s.x[b][1]);
+        EXPECT_NEAR(s.p[a] - s.p[b], hydrostatic, 1.1 * curvature + 1e-12 * eos.B()) << a << " " << b;
+      }
+    }
+    EXPECT_GT(highest, old.d[10] / 8) << "the pattern spans heights, so the pressures must differ";
+    EXPECT_NEAR(mean, rho, 1e-12 * rho);
+    for (std::size_t a = 23; a < 27; ++a) {  // the free-falling parent, after the 3 daughters of 10 moved it on
+      ASSERT_EQ(refine::parent_id(s.id[a]), old.id[20]);
+      EXPECT_EQ(s.rho[a], old.rho[20]);
+      EXPECT_EQ(s.rhoh[a], old.rhoh[20]);
+    }
+  }
 }
 
 std::vector<Vec<2>> sorted_positions(const ParticleStore<2>& s) {

@@ -1,5 +1,6 @@
 // effects.refinement.coupling in scene files: "buffered" is accepted where buffered levels are built, round-trips,
-// and is refused with a message naming the key where they are not (core/scene/scene_validator.cpp).
+// and is refused with a message naming the key where they are not (core/scene/scene_validator.cpp); and the daughters'
+// density rule, whose default follows the coupling.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -44,6 +45,27 @@ TEST(SceneCoupling, BufferedIsRefusedWhereItIsNotBuiltYet) {
       << error_of(with_static);
   doc["effects"]["refinement"]["coupling"] = "apr";
   EXPECT_EQ(error_of(doc), "scene error: effects.refinement.coupling: must be one of: mixed, buffered (got 'apr')");
+}
+
+// effects.refinement.daughter_density: absent, it follows the coupling (pressure_gradient with buffered, the paper's
+// parent copy with mixed); given, it holds for either coupling and round-trips; other names are refused.
+TEST(SceneCoupling, DaughterDensityFollowsTheCouplingUnlessGiven) {
+  Json doc = full_scene();
+  doc["fluid"][1]["level"] = 0;
+  const auto rule = [](const Json& d) { return scene_from_json(d).effects.refinement->daughter_density_rule(); };
+  EXPECT_EQ(rule(doc), sph::refine::DaughterDensity::parent);
+  Json buffered = doc;
+  buffered["effects"]["refinement"]["coupling"] = "buffered";
+  EXPECT_EQ(rule(buffered), sph::refine::DaughterDensity::pressure_gradient);
+  buffered["effects"]["refinement"]["daughter_density"] = "parent";
+  EXPECT_EQ(rule(buffered), sph::refine::DaughterDensity::parent);
+  doc["effects"]["refinement"]["daughter_density"] = "pressure_gradient";
+  EXPECT_EQ(rule(doc), sph::refine::DaughterDensity::pressure_gradient);
+  const Scene s = scene_from_json(doc);
+  EXPECT_EQ(scene_from_json(scene_to_json(s)), s);
+  doc["effects"]["refinement"]["daughter_density"] = "mean";
+  EXPECT_EQ(error_of(doc),
+            "scene error: effects.refinement.daughter_density: must be one of: parent, pressure_gradient (got 'mean')");
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <unordered_set>
+#include <utility>
 
 #include "core/refinement/family.hpp"
 
@@ -41,6 +42,30 @@ class Points {
 };
 
 }  // namespace
+
+template <int D>
+void tie_buffers(ParticleStore<D>& store) {
+  const std::size_t n = store.size();
+  std::vector<std::pair<ParticleId, std::size_t>> hosts;  // fluid hosts and buffers (a buffer can host buffers)
+  int top = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (store.kind[i] != Kind::fluid) continue;
+    if (store.role[i] == Role::host || store.role[i] == Role::buffer) hosts.emplace_back(store.id[i], i);
+    if (store.role[i] == Role::buffer) top = std::max(top, static_cast<int>(store.level[i]));
+  }
+  if (hosts.empty()) return;
+  std::sort(hosts.begin(), hosts.end());
+  auto view = store.view();
+  for (int l = 1; l <= top; ++l) {
+    par::parallel_for(n, [&](std::size_t i) {
+      if (view.kind[i] != Kind::fluid || view.role[i] != Role::buffer || view.level[i] != l) return;
+      const ParticleId parent = parent_id<D>(view.id[i]);
+      const auto it = std::lower_bound(hosts.begin(), hosts.end(), std::make_pair(parent, std::size_t{0}));
+      if (it == hosts.end() || it->first != parent) return;
+      view.x[i] = view.x[it->second] + view.tie[i];
+    });
+  }
+}
 
 template <int D>
 std::size_t prepare_buffered_marks(ParticleStore<D>& store, std::vector<std::uint8_t>& marks, int max_level) {
@@ -100,6 +125,8 @@ std::size_t prepare_buffered_marks(ParticleStore<D>& store, std::vector<std::uin
   return flipped.size();
 }
 
+template void tie_buffers<2>(ParticleStore<2>&);
+template void tie_buffers<3>(ParticleStore<3>&);
 template std::size_t prepare_buffered_marks<2>(ParticleStore<2>&, std::vector<std::uint8_t>&, int);
 template std::size_t prepare_buffered_marks<3>(ParticleStore<3>&, std::vector<std::uint8_t>&, int);
 

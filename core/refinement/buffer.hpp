@@ -10,7 +10,10 @@
 //   - an active particle within a fine particle's support of where the next level is active gets passive `buffer`
 //     daughters (it becomes a `host`), so the fine level's lattice reaches a support beyond its zone;
 //   - a passive particle takes its velocity and density from the active particles of the other levels (and their
-//     ghosts) by a linear moving least-squares fit, and moves with that velocity.
+//     ghosts) by a linear moving least-squares fit; a shadow moves with that velocity, a buffer particle keeps its
+//     place beside its host (tie_buffers);
+//   - daughters take their parent's density carried along its pressure gradient (split_pass.hpp, DaughterDensityIn),
+//     so that a split leaves a still tank's hydrostatic field as it was.
 // Active particles meet only their own level (the pair sweep, core/sweep.hpp). Passive ones are not fluid of their
 // own: the diagnostics, the probes and the output counts leave them out; frames keep them with their role.
 #include <Eigen/Dense>
@@ -84,6 +87,15 @@ void interpolate_passive(const ParticleView<D>& s, const CellGrid<D>& grid, cons
     s.rhoh[i] = rho;
   });
 }
+
+/// Puts every buffer particle back at its place beside its host (x_host + tie), level by level from the coarsest, so
+/// that a buffer whose host is itself a buffer follows it. Called after each drift: a buffer particle keeps its
+/// pattern around its host, which the active level's pressure holds in place. (Carried with its fitted velocity
+/// instead, the buffer lattice drifted from the fine level's, and the still tank's fine block with a wall zone at two
+/// levels turned in a slow eddy of 3-6 mm/s: docs/METHOD.md, "Buffered levels".) A buffer whose host is not in the
+/// store keeps the place the drift gave it.
+template <int D>
+void tie_buffers(ParticleStore<D>& store);
 
 /// Turns the criterion's marks (1: refine) into a buffered pass's (split_marked with buffered = true), on the store
 /// between steps (fluid, ghosts dropped or not):

@@ -26,6 +26,12 @@ enum class CriterionKind {
 /// particles of one level (and spacing) that lie in one cell of a lattice of the merged spacing.
 enum class MergeGroups { family, cell };
 
+/// effects.refinement.daughter_density: what density the daughters of a split take (core/refinement/split_pass.hpp).
+/// `parent`: the parent's (the paper's). `pressure_gradient`: the parent's, carried to each daughter's place along
+/// the pressure gradient the parent's momentum balance gives, so that a split in still water leaves the hydrostatic
+/// field as it is.
+enum class DaughterDensity { parent, pressure_gradient };
+
 struct CoarseningSettings {
   double v_threshold = 5.0;  // m/s
   int min_neighbours = 16;
@@ -45,6 +51,11 @@ struct RefinementSettings {
   int max_level = 1;        // daughters of level max_level are never refined
   std::optional<CoarseningSettings> coarsening;  // none: nothing ever merges
   LevelCoupling coupling = LevelCoupling::mixed;  // core/types.hpp, core/refinement/buffer.hpp
+  std::optional<DaughterDensity> daughter_density;  // none: pressure_gradient with buffered, parent with mixed
+  DaughterDensity daughter_density_rule() const {
+    return daughter_density.value_or(coupling == LevelCoupling::buffered ? DaughterDensity::pressure_gradient
+                                                                          : DaughterDensity::parent);
+  }
   bool operator==(const RefinementSettings&) const = default;
 };
 

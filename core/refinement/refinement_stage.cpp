@@ -93,8 +93,10 @@ bool RefinementStageIn<D>::after_step(SimulationT<D>& sim) {
     }
   }
   if (any) {
+    const DaughterDensityIn<D> density{settings_.daughter_density_rule(),
+                                       sim.settings().gravity.value_or(Vec<D>::Zero()), sim.settings().eos};
     const SplitResult r = split_marked(store, marks, settings_.pattern, settings_.rsp_k, settings_.max_level,
-                                       sim.settings().geometry.walls(), sim.time(), buffered);
+                                       sim.settings().geometry.walls(), sim.time(), buffered, density);
     rec.refined = r.refined;
     rec.shifted = r.shifted;
   }

@@ -14,7 +14,7 @@ namespace sph::refine {
 template <int D>
 SplitResult split_marked(ParticleStore<D>& store, const std::vector<std::uint8_t>& marks, Pattern pattern,
                          double rsp_k, int max_level, const std::vector<Wall<D>>& walls, double time,
-                         bool buffered) {
+                         bool buffered, const DaughterDensityIn<D>& density) {
   constexpr unsigned children = kChildren<D>;
   const std::size_t n = store.size();
   auto splits = [&](std::size_t i) {
@@ -78,9 +78,21 @@ SplitResult split_marked(ParticleStore<D>& store, const std::vector<std::uint8_t
     const double m = (1.0 / static_cast<double>(children)) * s.m[first], h = 0.5 * s.h[first], d = 0.5 * s.d[first];
     const std::int32_t level = s.level[first] + 1;
     const ParticleId parent = s.id[first];
+    // The parent's density, and the density gradient its last evaluation balanced (zero with the paper's rule).
+    const double rho = s.rho[first], rhoh = s.rhoh[first];
+    const Vec<D> grad_rho = density.rule == DaughterDensity::pressure_gradient
+                                ? Vec<D>(rho * (density.gravity - s.a[first]) / density.eos.sound_speed_squared(rho))
+                                : Vec<D>::Zero();
     for (std::size_t a = 0; a < children; ++a) {
       const std::size_t k = first + a;
       s.x[k] = xi + offsets[r][a];
+      s.tie[k] = offsets[r][a];
+      if (density.rule == DaughterDensity::pressure_gradient) {
+        const double change = grad_rho.dot(offsets[r][a]);
+        s.rho[k] = rho + change;
+        s.rhoh[k] = rhoh + change;
+        s.p[k] = density.eos.pressure(s.rho[k]);
+      }
       s.m[k] = m;
       s.h[k] = h;
       s.d[k] = d;
@@ -99,8 +111,10 @@ SplitResult split_marked(ParticleStore<D>& store, const std::vector<std::uint8_t
 }
 
 template SplitResult split_marked<2>(ParticleStore<2>&, const std::vector<std::uint8_t>&, Pattern, double, int,
-                                     const std::vector<Wall<2>>&, double, bool);
+                                     const std::vector<Wall<2>>&, double, bool,
+                                     const DaughterDensityIn<2>&);
 template SplitResult split_marked<3>(ParticleStore<3>&, const std::vector<std::uint8_t>&, Pattern, double, int,
-                                     const std::vector<Wall<3>>&, double, bool);
+                                     const std::vector<Wall<3>>&, double, bool,
+                                     const DaughterDensityIn<3>&);
 
 }  // namespace sph::refine

@@ -197,6 +197,7 @@ const char* to_string(Criterion v) { return choice_name(v); }
 const char* to_string(Outflow v) { return choice_name(v); }
 const char* to_string(Pattern v) { return choice_name(v); }
 const char* to_string(MergeGroups v) { return choice_name(v); }
+const char* to_string(DaughterDensity v) { return choice_name(v); }
 const char* to_string(ProbeKind v) { return choice_name(v); }
 const char* to_string(GhostPressure v) { return choice_name(v); }
 const char* to_string(TimeStepping v) { return choice_name(v); }

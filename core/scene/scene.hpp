@@ -86,6 +86,7 @@ using Slip = GhostSlip;
 using Criterion = refine::CriterionKind;
 using Pattern = refine::Pattern;
 using MergeGroups = refine::MergeGroups;
+using DaughterDensity = refine::DaughterDensity;
 using Coarsening = refine::CoarseningSettings;
 using Refinement = refine::RefinementSettings;
 
@@ -218,6 +219,7 @@ const char* to_string(Slip v);
 const char* to_string(Criterion v);
 const char* to_string(Pattern v);
 const char* to_string(MergeGroups v);
+const char* to_string(DaughterDensity v);
 const char* to_string(ProbeKind v);
 const char* to_string(Outflow v);
 const char* to_string(GhostPressure v);

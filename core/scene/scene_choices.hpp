@@ -54,6 +54,11 @@ struct Choices<LevelCoupling> {
       {{"mixed", LevelCoupling::mixed}, {"buffered", LevelCoupling::buffered}}};
 };
 template <>
+struct Choices<DaughterDensity> {
+  static constexpr std::array<Choice<DaughterDensity>, 2> table{
+      {{"parent", DaughterDensity::parent}, {"pressure_gradient", DaughterDensity::pressure_gradient}}};
+};
+template <>
 struct Choices<MergeGroups> {
   static constexpr std::array<Choice<MergeGroups>, 2> table{{{"family", MergeGroups::family}, {"cell", MergeGroups::cell}}};
 };

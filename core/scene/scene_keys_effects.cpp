@@ -164,6 +164,11 @@ const S<Refinement>& refinement_section() {
                     "region at one level; fluid that leaves the zone is not handed back yet")
               .means("how levels interact: every pair (`mixed`, the paper's), or each level with its own, its lattice "
                      "completed by passive particles fitted to the other levels (`buffered`, docs/METHOD.md)"));
+    d.add(value<Refinement>("daughter_density", member(&Refinement::daughter_density))
+              .default_text("`pressure_gradient` with `buffered`, `parent` with `mixed`")
+              .means("the daughters' density: the parent's (`parent`, the paper's), or the parent's carried to each "
+                     "daughter along the pressure gradient its momentum balance gives (`pressure_gradient`, "
+                     "docs/METHOD.md)"));
     return d;
   }();
   return s;
