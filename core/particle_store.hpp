@@ -92,8 +92,8 @@ class ParticleStore {
   Field<VecD> jerk{"jerk", "m/s^3"};
   Field<double> density_jerk{"density_jerk", "kg/m^3/s^2"};
   Field<Role> role{"role", "1"};  // core/types.hpp
-  // A daughter's place relative to its parent when it took it (its split, or a handover that kept it as a buffer). A
-  // buffer particle (buffered coupling) keeps that place: it moves with its host (core/refinement/buffer.hpp).
+  // A daughter's place relative to its parent when its split put it there (zero for the set-up's particles and a
+  // merge's). A buffer particle (buffered coupling) keeps that place: it moves with its host (core/refinement/buffer.hpp).
   Field<VecD> tie{"tie_offset", "m"};
 
   /// The registry: every field as a pointer to member. Adding a field above and here is all it takes for

@@ -182,6 +182,7 @@ MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::
     s.id[k] = merged_id;
     s.level_time[k] = time;
     s.origin[k] = Origin::fresh_merge;
+    s.tie[k].setZero();  // it took no place beside a parent (and a member's would depend on which one holds it)
     s.a[k].setZero();  // the rates are re-evaluated after the pass
     s.drho[k] = 0.0;
     s.kick[k].setZero();
