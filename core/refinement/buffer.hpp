@@ -91,9 +91,9 @@ void interpolate_passive(const ParticleView<D>& s, const CellGrid<D>& grid, cons
 /// Puts every buffer particle back at its place beside its host (x_host + tie), level by level from the coarsest, so
 /// that a buffer whose host is itself a buffer follows it. Called after each drift: a buffer particle keeps its
 /// pattern around its host, which the active level's pressure holds in place. (Carried with its fitted velocity
-/// instead, the buffer lattice drifted from the fine level's, and the still tank's fine block with a wall zone at two
-/// levels turned in a slow eddy of 3-6 mm/s: docs/METHOD.md, "Buffered levels".) A buffer whose host is not in the
-/// store keeps the place the drift gave it.
+/// instead, the buffer lattice drifts from the fine level's: the still tank's wall zone at two levels then moved at
+/// 1.76x the unrefined tank's speed, tied at 1.32x; docs/METHOD.md, "Buffered levels".) A buffer whose host is not
+/// in the store keeps the place the drift gave it.
 template <int D>
 void tie_buffers(ParticleStore<D>& store);
 

@@ -18,7 +18,7 @@ namespace sph::refine {
 /// the pressure gradient grad p = rho (g - a) that its last evaluation's acceleration a balanced (the viscous force
 /// neglected), through the equation of state (c^2 = dp/drho). At rest this is the hydrostatic gradient; copying the
 /// parent's density instead (`parent`, the paper's) puts the upper daughters' pressure above the field's and the lower
-/// ones' below it, by rho g |o_k|. The offsets sum to zero (but where the wall rule shifts a pattern, along with its
+/// ones' below it, by |rho g . o_k|. The offsets sum to zero (but where the wall rule shifts a pattern, along with its
 /// centroid), so the family's mean density is the parent's to first order, and the pass's elastic energy changes at
 /// second order only.
 template <int D>
