@@ -216,8 +216,6 @@ TEST(Runner3D, ResumedRunIsBitwiseIdenticalToTheUninterruptedOne) {
   EXPECT_EQ(lines(io::RunFiles{c_dir}.series()), lines(io::RunFiles{a_dir}.series()));
 }
 
-}  // namespace
-
 TEST(Scene3D, BufferedLevelsAreRefusedIn3D) {
   Json doc = tank_doc();
   ASSERT_EQ(error_of(doc), "");
@@ -225,3 +223,5 @@ TEST(Scene3D, BufferedLevelsAreRefusedIn3D) {
   EXPECT_EQ(error_of(doc).rfind("scene error: effects.refinement.coupling: \"buffered\" is 2D only so far", 0), 0u)
       << error_of(doc);
 }
+
+}  // namespace
