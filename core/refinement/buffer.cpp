@@ -75,6 +75,28 @@ std::size_t prepare_buffered_marks(ParticleStore<D>& store, std::vector<std::uin
   for (std::size_t i = 0; i < n; ++i) {
     if (fluid(i) && has_parent(store.id[i])) parents.insert(parent_id<D>(store.id[i]));
   }
+  // Fluid of two levels that a flow has mixed: an active particle of level l with an active particle of level l + 1
+  // within kIntermixReach d_l of it shares its place with the finer level, so it is marked as if the zone covered it
+  // (a host turns into a shadow below, a particle without daughters is split). Decided on the store as it came.
+  std::vector<std::uint8_t> mixed(n, 0);
+  for (int l = 0; l < max_level; ++l) {
+    double reach = 0.0;
+    Points<D> finer;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!fluid(i)) continue;
+      if (store.level[i] == l) reach = std::max(reach, kIntermixReach * store.d[i]);
+      if (store.level[i] == l + 1 && !is_passive(store.role[i])) finer.add(store.x[i]);
+    }
+    if (!(reach > 0.0) || finer.empty()) continue;
+    finer.sort(reach);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (fluid(i) && store.level[i] == l && !is_passive(store.role[i]) &&
+          finer.near(store.x[i], kIntermixReach * store.d[i])) {
+        mixed[i] = 1;
+      }
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) marks[i] = marks[i] || mixed[i];
   // A marked host: its zone now covers it. It turns into a shadow, and its daughters take over as active.
   std::unordered_set<ParticleId> flipped;
   for (std::size_t i = 0; i < n; ++i) {

@@ -13,7 +13,9 @@
 //     ghosts) by a linear moving least-squares fit; a shadow moves with that velocity, a buffer particle keeps its
 //     place beside its host (tie_buffers);
 //   - daughters take their parent's density carried along its pressure gradient (split_pass.hpp, DaughterDensityIn),
-//     so that a split leaves a still tank's hydrostatic field as it was.
+//     so that a split leaves a still tank's hydrostatic field as it was;
+//   - where a flow mixes fine fluid into coarse, the coarse particles it reaches are refined (kIntermixReach), so that
+//     the band's buffer particles never lie on top of active fine ones.
 // Active particles meet only their own level (the pair sweep, core/sweep.hpp). Passive ones are not fluid of their
 // own: the diagnostics, the probes and the output counts leave them out; frames keep them with their role.
 #include <Eigen/Dense>
@@ -121,8 +123,20 @@ void interpolate_passive(const ParticleView<D>& s, const CellGrid<D>& grid, cons
 template <int D>
 void tie_buffers(ParticleStore<D>& store);
 
+/// How close (in its own spacing d_l) an active particle of level l may come to an active particle of level l + 1
+/// before the pass gives its place to the finer level (prepare_buffered_marks). Each level's lattice is completed by
+/// passive particles of the other, so fluid of two levels that a flow mixes (fine particles carried out of their
+/// zone among coarse ones) puts two lattices of one level on top of each other: the band's buffer particles beside
+/// active fine ones. The dam break with a zone stopped so, at 2.1-3.2 s (docs/METHOD.md, "Buffered levels"). Where a
+/// zone's edge stays still, no active particle of level l has one of level l + 1 nearer than 0.75 d_l (a split's
+/// daughters sit d_l / 4 from their parent in each axis, which is d_l from the nearest active particle of level l).
+/// 0.6 is a tuned value: 0.5 left two of the four dam-break zones stopping (at 2.67 s and 3.39 s), 0.6 let all four
+/// complete, and the still tanks are unchanged.
+inline constexpr double kIntermixReach = 0.6;
+
 /// Turns the criterion's marks (1: refine) into a buffered pass's (split_marked with buffered = true), on the store
 /// between steps (fluid, ghosts dropped or not):
+///   - an active particle of level l within kIntermixReach d_l of an active particle of level l + 1 is marked;
 ///   - a marked host becomes a shadow and its buffer daughters active (its zone grew over it): no split;
 ///   - a mark on a particle that is passive or already has daughters is dropped;
 ///   - an unmarked active or buffer particle of level l < max_level without daughters, within h_l + d_l (a daughter's

@@ -161,7 +161,8 @@ const S<Refinement>& refinement_section() {
     d.add(value<Refinement>("coupling", member(&Refinement::coupling))
               .only_for({"zone"})
               .note("`buffered`: 2D, one process, `time.stepping` global, no coarsening or static refinement, every fluid "
-                    "region at one level; fluid that leaves the zone is not handed back yet")
+                    "region at one level; fine fluid that leaves the zone stays fine, and coarse fluid it mixes with is "
+                    "refined")
               .means("how levels interact: every pair (`mixed`, the paper's), or each level with its own, its lattice "
                      "completed by passive particles fitted to the other levels (`buffered`, docs/METHOD.md)"));
     d.add(value<Refinement>("daughter_density", member(&Refinement::daughter_density))
