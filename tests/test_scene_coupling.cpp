@@ -29,11 +29,16 @@ TEST(SceneCoupling, BufferedIsRefusedWhereItIsNotBuiltYet) {
   Json per_level = doc;
   per_level["time"]["stepping"] = "per_level";
   EXPECT_EQ(error_of(per_level).rfind(refused + "needs time.stepping \"global\"", 0), 0u) << error_of(per_level);
-  Json velocity = doc;
+  Json velocity = doc;  // the paper's criterion: buffered levels follow it (the dam break and the drop complete)
   velocity["effects"]["refinement"] = Json{{"v_threshold", 5}, {"coupling", "buffered"}};
-  EXPECT_EQ(error_of(velocity).rfind("scene error: effects.refinement.coupling: unknown key; allowed for criterion velocity", 0),
-            0u)
-      << error_of(velocity);
+  EXPECT_EQ(error_of(velocity), "");
+  EXPECT_EQ(scene_from_json(velocity).effects.refinement->coupling, sph::LevelCoupling::buffered);
+  Json few = doc;
+  few["effects"]["refinement"] = Json{{"criterion", "few_neighbours"}, {"min_neighbours", 8}, {"coupling", "buffered"}};
+  EXPECT_EQ(
+      error_of(few).rfind("scene error: effects.refinement.coupling: unknown key; allowed for criterion few_neighbours", 0),
+      0u)
+      << error_of(few);
   Json two_levels = doc;
   two_levels["fluid"][1]["level"] = 1;
   EXPECT_EQ(error_of(two_levels).rfind(refused + "needs every fluid region at one starting level", 0), 0u)

@@ -159,7 +159,7 @@ const S<Refinement>& refinement_section() {
               .default_text("none (nothing merges)")
               .means("families merge back where the flow no longer needs them"));
     d.add(value<Refinement>("coupling", member(&Refinement::coupling))
-              .only_for({"zone"})
+              .only_for({"zone", "velocity"})
               .note("`buffered`: 2D, one process, `time.stepping` global, no coarsening or static refinement, every fluid "
                     "region at one level; fine fluid that leaves the zone stays fine, and coarse fluid it mixes with is "
                     "refined")
