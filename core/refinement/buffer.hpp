@@ -128,10 +128,10 @@ void tie_buffers(ParticleStore<D>& store);
 /// passive particles of the other, so fluid of two levels that a flow mixes (fine particles carried out of their
 /// zone among coarse ones) puts two lattices of one level on top of each other: the band's buffer particles beside
 /// active fine ones. The dam break with a zone stopped so, at 2.1-3.2 s (docs/METHOD.md, "Buffered levels"). Where a
-/// zone's edge stays still, no active particle of level l has one of level l + 1 nearer than 0.75 d_l (a split's
-/// daughters sit d_l / 4 from their parent in each axis, which is d_l from the nearest active particle of level l).
-/// 0.6 is a tuned value: 0.5 left two of the four dam-break zones stopping (at 2.67 s and 3.39 s), 0.6 let all four
-/// complete, and the still tanks are unchanged.
+/// zone's edge stays still, no active particle of level l has one of level l + 1 nearer than 0.75 d_l with AAP (a
+/// daughter sits d_l / 4 from its parent in each axis, and the parent, a shadow, d_l from the nearest active particle
+/// of level l). 0.6 is a tuned value: 0.5 left two of the four AAP dam-break zones stopping (at 2.67 s and 3.39 s),
+/// 0.6 let all four complete, and the still tanks (RSP too) are unchanged.
 inline constexpr double kIntermixReach = 0.6;
 
 /// Turns the criterion's marks (1: refine) into a buffered pass's (split_marked with buffered = true), on the store
