@@ -13,9 +13,14 @@
 //              v = vh + (t_k - t_mid) a + e (t_k - t_n)^2 / 2 jerk, and the same for rho with drho and its jerk;
 //              t_n and t_mid the start and middle of i's own step, e = 1 with time.predictor = "extrapolated" (the
 //              rates extrapolated linearly from the particle's last two evaluations: jerk = their difference over
-//              the time between them, core/sweep.hpp), 0 with "last_rate" (the last evaluation's rates held)
+//              the time between them, core/sweep.hpp), 0 with "last_rate" (the last evaluation's rates held).
+//              Inside i's step, where it has pairs in finer bins than its own (full_a != a), vh lacks the share
+//              of those pairs' impulses not yet delivered, so the prediction starts from the step's start instead:
+//              v = v_open + (t_k - t_n) full_a + e (t_k - t_n)^2 / 2 jerk, full_a the rate of all its pairs at
+//              full weight (sweep.hpp), v_open its velocity at t_n (docs/METHOD.md, "Prediction inside a step")
 //     forces:  the pairs with b_ij >= the active bin of substep k (core/sweep.hpp), each weighted by 2^-b_ij
-//     kick:    k < K:  vh += dt0 kick, rhoh += dt0 kick_rho  (a closing and an opening half-kick at once)
+//     kick:    k < K:  vh += dt0 kick, rhoh += dt0 kick_rho  (a closing and an opening half-kick at once); where
+//                      k ends i's own step, first v_open = vh + (dt0 / 2) kick (its velocity at the new step's start)
 //              k = K:  v = vh + (dt0 / 2) kick, rho = rhoh + (dt0 / 2) kick_rho  (every pair closes)
 // Bins change between steps only. Before the last evaluation each particle's next bin is chosen (bin_for); where
 // any changes, that evaluation sums every pair twice, with this step's weights for the closing kick and with the
@@ -232,12 +237,18 @@ class Integrator {
     return {finest - trailing, bin_cap()};
   }
 
-  /// Opening half-kick of a step of dt0 (fluid particles only).
+  /// Opening half-kick of a step of dt0 in 2^finest substeps (fluid particles only). A particle whose step spans
+  /// several substeps also keeps its velocity and density at the step's start (v_open, rho_open: drift).
   template <int D>
-  void open(const ParticleView<D>& s, std::size_t i, double dt0) const {
-    const double half = (0.5 * dt0) * kBinWeight[static_cast<std::size_t>(bin(s.bin[i]))];
+  void open(const ParticleView<D>& s, std::size_t i, double dt0, int finest) const {
+    const int b = bin(s.bin[i]);
+    const double half = (0.5 * dt0) * kBinWeight[static_cast<std::size_t>(b)];
     s.vh[i] = s.v[i] + half * s.a[i];
     s.rhoh[i] = s.rho[i] + half * s.drho[i];
+    if (b < finest) {
+      s.v_open[i] = s.v[i];
+      s.rho_open[i] = s.rho[i];
+    }
   }
 
   /// Drift over substep k of 2^finest (tau = dt0 / 2^finest) and the prediction of v, rho and p at t_k.
@@ -247,11 +258,20 @@ class Integrator {
     const int period = 1 << (finest - bin(s.bin[i]));  // substeps per step of i's bin
     const int start = ((k - 1) / period) * period;       // substep at which i's current step began
     const double offset = static_cast<double>(2 * (k - start) - period) * (0.5 * tau);  // t_k - t_mid
-    if (predictor_ == TimePredictor::extrapolated) {
+    const double since = static_cast<double>(k - start) * tau;  // t_k - t_n
+    const double e = predictor_ == TimePredictor::extrapolated ? 1.0 : 0.0;
+    const double half_square = e * (0.5 * since * since);
+    if (k - start < period && (s.full_a[i] != s.a[i] || s.full_drho[i] != s.drho[i])) {
+      // Inside i's step, with pairs of finer bins than its own: vh holds only the impulses those pairs have delivered
+      // so far (a finer pair's opening kick and its kicks at the substeps it was due), not their share up to t_k, so
+      // vh + offset a falls short by up to a quarter step of their force (a pair one bin finer, at i's mid-step): in a
+      // still tank with a strip of particles a bin finer, 0.42 m/s after 4 s against 0.009 m/s (docs/METHOD.md,
+      // "Prediction inside a step"). The motion from the step's start with every pair at full weight has no such gap.
+      s.v[i] = s.v_open[i] + since * s.full_a[i] + half_square * s.jerk[i];
+      s.rho[i] = s.rho_open[i] + since * s.full_drho[i] + half_square * s.density_jerk[i];
+    } else if (predictor_ == TimePredictor::extrapolated) {
       // The rates a + (t - t_n) jerk integrated from t_n: vh holds v_n + (t_mid - t_n) a, so this adds the jerk's
       // (t_k - t_n)^2 / 2 (exact for rates linear in time).
-      const double since = static_cast<double>(k - start) * tau;  // t_k - t_n
-      const double half_square = 0.5 * since * since;
       s.v[i] = s.vh[i] + offset * s.a[i] + half_square * s.jerk[i];
       s.rho[i] = s.rhoh[i] + offset * s.drho[i] + half_square * s.density_jerk[i];
     } else {
@@ -269,17 +289,25 @@ class Integrator {
     s.x[i] += tau * s.v[i];
   }
 
+  /// Kick with the evaluation of substep k of 2^finest: closing at the end of the coarse step (k = 2^finest), else a
+  /// closing and an opening kick at once. Where that closes i's own step (k a multiple of its period), the closing
+  /// half gives its velocity and density at the start of its next step (v_open, rho_open: Integrator::drift).
   template <int D>
-  void kick(const ParticleView<D>& s, std::size_t i, double dt0, bool closing) const {
-    if (closing) {
-      const double half = 0.5 * dt0;
+  void kick(const ParticleView<D>& s, std::size_t i, double dt0, int k, int finest) const {
+    const double half = 0.5 * dt0;
+    if (k == 1 << finest) {
       s.v[i] = s.vh[i] + half * s.kick[i];
       s.rho[i] = s.rhoh[i] + half * s.kick_rho[i];
       s.p[i] = eos_.pressure(s.rho[i]);
-    } else {
-      s.vh[i] += dt0 * s.kick[i];
-      s.rhoh[i] += dt0 * s.kick_rho[i];
+      return;
     }
+    const int period = 1 << (finest - bin(s.bin[i]));
+    if (k % period == 0) {
+      s.v_open[i] = s.vh[i] + half * s.kick[i];
+      s.rho_open[i] = s.rhoh[i] + half * s.kick_rho[i];
+    }
+    s.vh[i] += dt0 * s.kick[i];
+    s.rhoh[i] += dt0 * s.kick_rho[i];
   }
 
  private:

@@ -44,6 +44,10 @@ struct ParticleView {
   double* density_jerk = nullptr;
   Role* role = nullptr;
   Vec<D>* tie = nullptr;
+  Vec<D>* full_a = nullptr;
+  double* full_drho = nullptr;
+  Vec<D>* v_open = nullptr;
+  double* rho_open = nullptr;
 };
 
 template <int D>
@@ -95,6 +99,14 @@ class ParticleStore {
   // A daughter's place relative to its parent when its split put it there (zero for the set-up's particles and a
   // merge's). A buffer particle (buffered coupling) keeps that place: it moves with its host (core/refinement/buffer.hpp).
   Field<VecD> tie{"tie_offset", "m"};
+  // Time bins: the rates of every pair at full weight, whatever its bin (a and drho weigh a pair of a finer bin than
+  // the particle's by 2^(b_i - b_ij), as its opening kick needs; equal to them where every pair is in the particle's
+  // own bin), and the velocity and density at the start of the particle's current step. Between its own evaluations
+  // the integrator predicts v and rho from them (Integrator::drift).
+  Field<VecD> full_a{"acceleration_all_pairs", "m/s^2"};
+  Field<double> full_drho{"density_rate_all_pairs", "kg/m^3/s"};
+  Field<VecD> v_open{"velocity_at_step_start", "m/s"};
+  Field<double> rho_open{"density_at_step_start", "kg/m^3"};
 
   /// The registry: every field as a pointer to member. Adding a field above and here is all it takes for
   /// every operation (gather, compaction, expansion, copies, output, checkpoints) to carry it.
@@ -106,7 +118,8 @@ class ParticleStore {
                            &ParticleStore::origin, &ParticleStore::kick, &ParticleStore::kick_rho,
                            &ParticleStore::bin, &ParticleStore::next_bin, &ParticleStore::stiffness,
                            &ParticleStore::dt_limit, &ParticleStore::jerk, &ParticleStore::density_jerk,
-                           &ParticleStore::role, &ParticleStore::tie);
+                           &ParticleStore::role, &ParticleStore::tie, &ParticleStore::full_a,
+                           &ParticleStore::full_drho, &ParticleStore::v_open, &ParticleStore::rho_open);
   }
 
   /// Visits every field. f is called with each Field<T>&.
@@ -213,7 +226,8 @@ class ParticleStore {
     return {size(), x.data(), v.data(), rho.data(), p.data(), m.data(), h.data(), d.data(),
             level.data(), kind.data(), id.data(), drho.data(), a.data(), vh.data(), rhoh.data(), level_time.data(),
             origin.data(), kick.data(), kick_rho.data(), bin.data(), next_bin.data(), stiffness.data(), dt_limit.data(),
-            jerk.data(), density_jerk.data(), role.data(), tie.data()};
+            jerk.data(), density_jerk.data(), role.data(), tie.data(), full_a.data(), full_drho.data(), v_open.data(),
+            rho_open.data()};
   }
 
   /// Bytes held by every field (data and scratch), for memory reports.
@@ -225,7 +239,7 @@ class ParticleStore {
 
   /// Bytes one particle occupies across all fields.
   static constexpr std::size_t bytes_per_particle() {
-    return 7 * sizeof(VecD) + 12 * sizeof(double) + 3 * sizeof(std::int32_t) + sizeof(Kind) + sizeof(ParticleId) +
+    return 9 * sizeof(VecD) + 14 * sizeof(double) + 3 * sizeof(std::int32_t) + sizeof(Kind) + sizeof(ParticleId) +
            sizeof(Origin) + sizeof(Role);
   }
 

@@ -436,9 +436,9 @@ StepInfo SimulationT<D>::step(double dt_cap) {
               integ.carry(s, i, tau);
             } else if (s.kind[i] == Kind::fluid) {
               if (k == 1) {
-                integ.open(s, i, dt);
+                integ.open(s, i, dt, finest);
               } else {
-                integ.kick(s, i, dt, false);
+                integ.kick(s, i, dt, k - 1, finest);
               }
               integ.drift(s, i, tau, k, finest);
             }
@@ -500,7 +500,7 @@ StepInfo SimulationT<D>::step(double dt_cap) {
     auto s = store_.view();
     par::parallel_for(s.n, [&](std::size_t i) {
       if (s.kind[i] != Kind::fluid) return;
-      if (!is_passive(s.role[i])) integ.kick(s, i, dt, true);
+      if (!is_passive(s.role[i])) integ.kick(s, i, dt, substeps, finest);
       s.bin[i] = s.next_bin[i];
     });
     limits_ = step_limits;

@@ -161,6 +161,21 @@ class PairSweep {
           const bool due = !Binned || bi >= act.active_bin;
           PairSums<D> acc;
           PairSums<D> next;  // with act.rebin: the sums weighted by the next bins
+          // A due particle's pairs by their bin b_ij (binned loop), each class weighted 2^-b_ij as in acc; acc is then
+          // their sum in class order, and the full-weight rates (full_a) sum them at 2^b_ij. A particle whose pairs are
+          // all of its own bin has one class, so acc takes the same terms in the same order as without classes.
+          std::array<PairSums<D>, Binned && !Rebin ? kBinCount : 1> by_bin;
+          std::uint32_t bins_used = 0;
+          const auto sums_of = [&](int b) -> PairSums<D>& {
+            if (!Binned || Rebin || !due) return acc;
+            const auto k = static_cast<std::size_t>(b);
+            if (!(bins_used & (1u << b))) {
+              by_bin[k] = PairSums<D>{};
+              bins_used |= 1u << b;
+            }
+            return by_bin[k];
+          };
+          PairSums<D> full;  // with act.rebin: the sums at full weight
           double mu_max = 0.0;
           double grad_mass = 0.0;  // sum_j m_j |grad W_ij| over the fluid and ghost pairs: the acoustic stiffness
           std::size_t pairs = 0, candidates = 0;
@@ -215,13 +230,15 @@ class PairSweep {
                 if constexpr (has_wall_effects) {
                   if constexpr (!Rebin) {
                     pr.weight = Binned ? kBinWeight[static_cast<std::size_t>(bi)] : 1.0;
-                    std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, wall_);
+                    PairSums<D>& into = sums_of(bi);
+                    std::apply([&](const auto&... eff) { (eff(s, pr, into), ...); }, wall_);
                   } else {
                     PairSums<D> one;
                     pr.weight = 1.0;
                     std::apply([&](const auto&... eff) { (eff(s, pr, one), ...); }, wall_);
                     add_weighted(acc, one, bi);
                     add_weighted(next, one, nbi);
+                    add_weighted(full, one, 0);
                   }
                 }
                 continue;
@@ -245,7 +262,8 @@ class PairSweep {
                 // 2^-b_ij scales every fluid pair term (each is linear in grad W); a power of two, so exact.
                 pr.weight = kBinWeight[static_cast<std::size_t>(bij)];
                 pr.gradW = (pr.weight * factor) * xij;
-                std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, fluid_);
+                PairSums<D>& into = sums_of(bij);
+                std::apply([&](const auto&... eff) { (eff(s, pr, into), ...); }, fluid_);
               } else {  // the pair once at weight 1, then at this step's and at the next step's weight
                 const int nbj = act.bin(s.next_bin[j]);
                 PairSums<D> one;
@@ -254,6 +272,7 @@ class PairSweep {
                 std::apply([&](const auto&... eff) { (eff(s, pr, one), ...); }, fluid_);
                 add_weighted(acc, one, bij);
                 add_weighted(next, one, nbi > nbj ? nbi : nbj);
+                add_weighted(full, one, 0);
               }
               mu_max = std::max(mu_max, std::abs(pr.mu));
             }
@@ -264,6 +283,24 @@ class PairSweep {
             s.kick[i] = acc.a;
             s.kick_rho[i] = acc.drho;
             return lim;
+          }
+          if constexpr (Binned && !Rebin) {  // acc and full from the classes (bins_used: the one class, or several)
+            bool first = true;
+            for (int b = bi; b < kBinCount; ++b) {
+              if (!(bins_used & (1u << b))) continue;
+              const PairSums<D>& c = by_bin[static_cast<std::size_t>(b)];
+              if (first) {
+                acc = c;
+                full.a = kBinScale[static_cast<std::size_t>(b)] * c.a;
+                full.drho = kBinScale[static_cast<std::size_t>(b)] * c.drho;
+                first = false;
+              } else {
+                acc.a += c.a;
+                acc.drho += c.drho;
+                full.a += kBinScale[static_cast<std::size_t>(b)] * c.a;
+                full.drho += kBinScale[static_cast<std::size_t>(b)] * c.drho;
+              }
+            }
           }
           acc.a += kBinWeight[static_cast<std::size_t>(bi)] * gravity_;
           s.kick[i] = acc.a;
@@ -278,13 +315,23 @@ class PairSweep {
           {
             const Vec<D> a_new = scale * next.a;
             const double drho_new = scale * next.drho;
+            // The rates at full weight: a and drho themselves where every pair is of i's own bin (bitwise: the classes'
+            // scalings are powers of two), the single-rate loop included.
+            Vec<D> full_a_new = a_new;
+            double full_drho_new = drho_new;
+            if constexpr (Binned) {
+              full_a_new = full.a + gravity_;
+              full_drho_new = full.drho;
+            }
             if (act.dt0 > 0.0) {  // the rates' change since i's last evaluation, dt0 2^-b_i ago (Integrator::drift)
               const double since = act.dt0 * kBinWeight[static_cast<std::size_t>(bi)];
-              s.jerk[i] = (a_new - s.a[i]) / since;
-              s.density_jerk[i] = (drho_new - s.drho[i]) / since;
+              s.jerk[i] = (full_a_new - s.full_a[i]) / since;
+              s.density_jerk[i] = (full_drho_new - s.full_drho[i]) / since;
             }
             s.a[i] = a_new;
             s.drho[i] = drho_new;
+            s.full_a[i] = full_a_new;
+            s.full_drho[i] = full_drho_new;
           }
           const double an = s.a[i].norm();
           const double own_force = an > 0.0 ? std::sqrt(hi / an) : inf;

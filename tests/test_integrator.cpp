@@ -59,12 +59,12 @@ TEST(Integrator, ThePredictionIsExactForRatesLinearInTime) {
     store.bin[0] = store.next_bin[0] = 1;
     store.v[0] = v0;
     store.rho[0] = rho0;
-    store.a[0] = a0;
-    store.drho[0] = drho0;
+    store.a[0] = store.full_a[0] = a0;  // every pair in the particle's own bin: a is the rate at full weight
+    store.drho[0] = store.full_drho[0] = drho0;
     store.jerk[0] = jerk;
     store.density_jerk[0] = density_jerk;
     const auto s = store.view();
-    integ.open(s, 0, dt0);
+    integ.open(s, 0, dt0, 2);
     const double step = 0.5 * dt0;  // bin 1
     for (int k = 1; k <= 4; ++k) {
       if (k == 3) {  // the second step opens: the rates at t = step, as the exact motion has them
@@ -74,8 +74,8 @@ TEST(Integrator, ThePredictionIsExactForRatesLinearInTime) {
         // closes to the trapezoid of a_n and a1, exact for a linear rate) and the opening one with a1.
         s.vh[0] += step * a1;
         s.rhoh[0] += step * drho1;
-        s.a[0] = a1;
-        s.drho[0] = drho1;
+        s.a[0] = s.full_a[0] = a1;
+        s.drho[0] = s.full_drho[0] = drho1;
       }
       integ.drift(s, 0, tau, k, 2);
       const double t = k * tau;                 // since the first step's start
@@ -97,6 +97,69 @@ TEST(Integrator, ThePredictionIsExactForRatesLinearInTime) {
     EXPECT_NEAR(s.rho[0], rho_start + step * drho1 + e * 0.5 * step * step * density_jerk, 1e-13 * rho0);
     if (predictor == TimePredictor::extrapolated) {
       EXPECT_NEAR(s.rho[0], rho0 + t * drho0 + 0.5 * t * t * density_jerk, 1e-13 * rho0);
+    }
+  }
+}
+
+// The prediction inside a step of a particle with pairs of finer bins than its own. Its forces split into classes by
+// the pairs' bins: F_c from the pairs of bin c (gravity in its own bin's). The sweep gives it a = 2^b sum_c 2^-c F_c
+// (each class weighted for its own step) and the full-weight rate A = sum_c F_c; a finer class delivers its impulses
+// at its own substeps (the driver's combined kick, vh += dt0 kick). With forces constant in time the motion is
+// v(t) = v_n + (t - t_n) A, and the prediction at every substep must be that, whichever classes have delivered.
+// vh + (t_k - t_mid) a, the prediction before, falls short by a quarter step of a one-bin-finer class at the
+// particle's mid-step (docs/METHOD.md, "Prediction inside a step"). Two cases: bin 0 with classes 0 and 1 (two
+// substeps), and bin 1 with classes 1 and 2 over both its steps in a step of four substeps (the second opened by
+// the combined kick, which sets the start of its step, v_open). Tolerance as the test above: a few roundings of
+// sums of terms of order |v|, 1e-13 of the speed scale.
+TEST(Integrator, ThePredictionInsideAStepCountsTheFinerPairsAtFullWeight) {
+  const double dt0 = 0.1;
+  const Vec<2> v0(1.0, -2.0);
+  const double rho0 = 1000.0;
+  struct Case {
+    int bin, finest;
+    Vec<2> own, finer;       // F_b and F_(b+1)
+    double own_rho, finer_rho;
+  };
+  for (const Case& c : {Case{0, 1, Vec<2>(3.0, -9.0), Vec<2>(-2.0, 8.0), 5.0, -40.0},
+                        Case{1, 2, Vec<2>(-1.0, 4.0), Vec<2>(6.0, -3.0), -7.0, 25.0}}) {
+    for (const TimePredictor predictor : {TimePredictor::extrapolated, TimePredictor::last_rate}) {
+      SCOPED_TRACE(testing::Message() << "bin " << c.bin << (predictor == TimePredictor::extrapolated ? ", extrapolated" : ", last_rate"));
+      const Integrator integ(TimeStepping::per_level, TaitEquationOfState{}, kDefaultBinJump, predictor);
+      const int substeps = 1 << c.finest, period = 1 << (c.finest - c.bin);
+      const double tau = dt0 / substeps, w_own = std::ldexp(1.0, -c.bin), w_finer = std::ldexp(1.0, -c.bin - 1);
+      ParticleStore<2> store;
+      store.resize(1);
+      store.kind[0] = Kind::fluid;
+      store.bin[0] = store.next_bin[0] = c.bin;
+      store.v[0] = v0;
+      store.rho[0] = rho0;
+      // The sweep's rates for these classes (2^b (2^-b F_b + 2^-(b+1) F_(b+1)), and at full weight), no jerk.
+      store.a[0] = std::ldexp(1.0, c.bin) * (w_own * c.own + w_finer * c.finer);
+      store.drho[0] = std::ldexp(1.0, c.bin) * (w_own * c.own_rho + w_finer * c.finer_rho);
+      store.full_a[0] = c.own + c.finer;
+      store.full_drho[0] = c.own_rho + c.finer_rho;
+      const Vec<2> A = store.full_a[0];
+      const double R = store.full_drho[0];
+      const auto s = store.view();
+      integ.open(s, 0, dt0, c.finest);
+      std::size_t inside = 0;
+      for (int k = 1; k <= substeps; ++k) {
+        integ.drift(s, 0, tau, k, c.finest);
+        const double t = k * tau;
+        EXPECT_LE((s.v[0] - (v0 + t * A)).norm(), 1e-13 * v0.norm()) << "substep " << k;
+        EXPECT_NEAR(s.rho[0], rho0 + t * R, 1e-13 * rho0) << "substep " << k;
+        inside += k % period != 0;
+        // The evaluation at t_k: the finer class is due at every substep, the particle's own at the end of its step.
+        const bool own_due = k % period == 0;
+        s.kick[0] = w_finer * c.finer + (own_due ? Vec<2>(w_own * c.own) : Vec<2>::Zero());
+        s.kick_rho[0] = w_finer * c.finer_rho + (own_due ? w_own * c.own_rho : 0.0);
+        integ.kick(s, 0, dt0, k, c.finest);
+      }
+      EXPECT_EQ(inside, static_cast<std::size_t>(substeps - substeps / period)) << "substeps inside the particle's steps";
+      EXPECT_GT(inside, 0u);
+      // The closing kick ends the coarse step at the exact motion too.
+      EXPECT_LE((s.v[0] - (v0 + dt0 * A)).norm(), 1e-13 * v0.norm());
+      EXPECT_NEAR(s.rho[0], rho0 + dt0 * R, 1e-13 * rho0);
     }
   }
 }

@@ -141,7 +141,9 @@ TEST(IoFrames, EveryDatasetCarriesItsUnits) {
       {"acceleration", "m/s^2"}, {"velocity_half", "m/s"}, {"density_half", "kg/m^3"}, {"level_time", "s"},
       {"origin", "1"},         {"kick_rate", "m/s^2"},      {"kick_density_rate", "kg/m^3/s"},
       {"time_bin", "1"}, {"time_step_limit", "s"},       {"next_time_bin", "1"},      {"acoustic_stiffness", "1"},
-      {"jerk", "m/s^3"}, {"density_jerk", "kg/m^3/s^2"}, {"role", "1"}, {"tie_offset", "m"}};
+      {"jerk", "m/s^3"}, {"density_jerk", "kg/m^3/s^2"}, {"role", "1"}, {"tie_offset", "m"},
+      {"acceleration_all_pairs", "m/s^2"}, {"density_rate_all_pairs", "kg/m^3/s"}, {"velocity_at_step_start", "m/s"},
+      {"density_at_step_start", "kg/m^3"}};
   std::string time_units;
   const fs::path frame = tmp.path() / "frame.h5";
   (void)io::write_frame(frame, "frame_000000", sim.store(), sim.time(), sim.step_count(), 0, {});

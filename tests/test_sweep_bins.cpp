@@ -129,8 +129,8 @@ TEST(Sweep, TimeBinsEqualBruteForce) {
   EXPECT_GT(differ, 50u);
 }
 
-// The jerk (Integrator::drift's extrapolation): a due particle's change of a and drho since its last evaluation over
-// the time between them, dt0 2^-b (Activity::dt0); an evaluation that ends no step (dt0 = 0, Simulation::refresh)
+// The jerk (Integrator::drift's extrapolation): a due particle's change of its rates at full weight (full_a, full_drho)
+// since its last evaluation over the time between them, dt0 2^-b (Activity::dt0); an evaluation that ends no step (dt0 = 0, Simulation::refresh)
 // and a particle that is not due leave it as it was. Exact: the sweep forms the same difference and quotient.
 TEST(Sweep, TheJerkIsTheRatesChangeOverTheTimeSinceTheLastEvaluation) {
   const SolverSettings st = twin_settings(true, true);
@@ -158,8 +158,8 @@ TEST(Sweep, TheJerkIsTheRatesChangeOverTheTimeSinceTheLastEvaluation) {
   const double dt0 = 0.01;
   for (const int active : {1, 0}) {
     SCOPED_TRACE(testing::Message() << "active bin " << active);
-    const std::vector<Vec<2>> a_before = s.a.values(), jerk_before = s.jerk.values();
-    const std::vector<double> drho_before = s.drho.values(), density_jerk_before = s.density_jerk.values();
+    const std::vector<Vec<2>> a_before = s.full_a.values(), jerk_before = s.jerk.values();
+    const std::vector<double> drho_before = s.full_drho.values(), density_jerk_before = s.density_jerk.values();
     sph::Activity act{active, sph::Integrator::kMaxBin};
     act.dt0 = dt0;
     sweep->run(s.view(), grid, act);
@@ -172,8 +172,8 @@ TEST(Sweep, TheJerkIsTheRatesChangeOverTheTimeSinceTheLastEvaluation) {
         continue;
       }
       const double since = s.bin[i] == 0 ? dt0 : 0.5 * dt0;
-      EXPECT_EQ(s.jerk[i], Vec<2>((s.a[i] - a_before[i]) / since)) << i;
-      EXPECT_EQ(s.density_jerk[i], (s.drho[i] - drho_before[i]) / since) << i;
+      EXPECT_EQ(s.jerk[i], Vec<2>((s.full_a[i] - a_before[i]) / since)) << i;
+      EXPECT_EQ(s.density_jerk[i], (s.full_drho[i] - drho_before[i]) / since) << i;
       changed += s.jerk[i] != Vec<2>::Zero();
     }
     EXPECT_GT(changed, 50u);

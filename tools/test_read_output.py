@@ -53,13 +53,12 @@ THROWN = {
     "output": {"frame_interval": 0.1},
 }
 
-UNITS = {"acceleration": "m/s^2", "acoustic_stiffness": "1", "density": "kg/m^3", "density_half": "kg/m^3", "density_jerk": "kg/m^3/s^2", "density_rate": "kg/m^3/s", "id": "1", "jerk": "m/s^3",
+UNITS = {"acceleration": "m/s^2", "acceleration_all_pairs": "m/s^2", "density_rate_all_pairs": "kg/m^3/s",
+         "velocity_at_step_start": "m/s", "density_at_step_start": "kg/m^3", "acoustic_stiffness": "1", "density": "kg/m^3", "density_half": "kg/m^3", "density_jerk": "kg/m^3/s^2", "density_rate": "kg/m^3/s", "id": "1", "jerk": "m/s^3",
          "kick_density_rate": "kg/m^3/s", "kick_rate": "m/s^2", "kind": "1", "level": "1", "level_time": "s", "mass": "kg/m", "origin": "1", "position": "m", "pressure": "Pa", "role": "1", "smoothing_length": "m",
          "next_time_bin": "1", "spacing": "m", "time_bin": "1", "time_step_limit": "s", "velocity": "m/s", "velocity_half": "m/s", "tie_offset": "m"}
 
-FIELDS = ["acceleration", "acoustic_stiffness", "density", "density_half", "density_jerk", "density_rate", "id", "jerk", "kick_density_rate", "kick_rate", "kind", "level", "level_time", "mass",
-          "next_time_bin", "origin", "position", "pressure", "role", "smoothing_length", "spacing", "tie_offset", "time_bin", "time_step_limit",
-          "velocity", "velocity_half"]
+FIELDS = sorted(UNITS)  # every field the store writes has its unit here: one list
 
 
 def main():

@@ -185,6 +185,8 @@ MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::
     s.tie[k].setZero();  // it took no place beside a parent (and a member's would depend on which one holds it)
     s.a[k].setZero();  // the rates are re-evaluated after the pass
     s.drho[k] = 0.0;
+    s.full_a[k].setZero();
+    s.full_drho[k] = 0.0;
     s.kick[k].setZero();
     s.kick_rho[k] = 0.0;
     s.jerk[k].setZero();  // no history of its own: its first step predicts from its first rates alone

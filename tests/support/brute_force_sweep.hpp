@@ -25,6 +25,8 @@ template <int D>
 struct ReferenceT {
   std::vector<double> drho, drho_scale, kick_rho;
   std::vector<Vec<D>> a, kick;
+  std::vector<double> full_drho, full_a_scale, full_drho_scale;  // every pair at weight 1 (full_a and full_drho)
+  std::vector<Vec<D>> full_a;
   std::vector<std::uint8_t> due;
   std::vector<double> a_scale;
   double dt_force = std::numeric_limits<double>::infinity();
@@ -47,6 +49,10 @@ ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<
   ref.drho_scale.assign(n, 0.0);
   ref.kick_rho.assign(n, 0.0);
   ref.a.assign(n, Vec<D>::Zero());
+  ref.full_a.assign(n, Vec<D>::Zero());
+  ref.full_drho.assign(n, 0.0);
+  ref.full_a_scale.assign(n, 0.0);
+  ref.full_drho_scale.assign(n, 0.0);
   ref.kick.assign(n, Vec<D>::Zero());
   ref.due.assign(n, 0);
   ref.a_scale.assign(n, 0.0);
@@ -64,6 +70,8 @@ ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<
     const double wi = std::pow(2.0, -bi), nwi = std::pow(2.0, -nbi);
     Vec<D> ai = due ? Vec<D>(wi * g) : Vec<D>(Vec<D>::Zero());
     Vec<D> next_ai = due ? Vec<D>(nwi * g) : Vec<D>(Vec<D>::Zero());  // weighted by the next bins
+    Vec<D> full_ai = g;  // every pair at weight 1
+    double full_drho = 0.0, full_scale = g.norm(), full_drho_scale = 0.0;
     double scale = g.norm(), drho = 0.0, next_drho = 0.0, drho_scale = 0.0, mu_max = 0.0, grad_mass = 0.0;
     for (std::size_t j = 0; j < n; ++j) {
       if (j == i) continue;
@@ -81,6 +89,8 @@ ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<
         const Vec<D> f = st.lennard_jones->strength * (std::pow(r0 / r, 12) - std::pow(r0 / r, 6)) * xij / (r * r);
         ai += wi * f;
         next_ai += nwi * f;
+        full_ai += f;
+        full_scale += f.norm();
         scale += wi * f.norm();
         continue;
       }
@@ -108,6 +118,8 @@ ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<
       }
       drho += w * dr;
       next_drho += nw * dr;
+      full_drho += dr;
+      full_drho_scale += cond * std::abs(dr);
       drho_scale += cond * std::abs(w * dr);
       double bracket = s.p[i] / (s.rho[i] * s.rho[i]) + s.p[j] / (s.rho[j] * s.rho[j]);  // eq. (6)
       const double mu = hij * vij.dot(xij) / (r * r + 0.01 * hij * hij);
@@ -126,6 +138,8 @@ ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<
       const Vec<D> f = -s.m[j] * bracket * gradW;
       ai += w * f;
       next_ai += nw * f;
+      full_ai += f;
+      full_scale += cond * f.norm();
       scale += cond * w * f.norm();
     }
     ref.kick[i] = ai;
@@ -137,6 +151,10 @@ ReferenceT<D> brute_force(const ParticleStore<D>& s, const sph::SolverSettingsT<
     const double up = std::pow(2.0, nbi);
     ref.a[i] = up * next_ai;
     ref.drho[i] = up * next_drho;
+    ref.full_a[i] = full_ai;
+    ref.full_drho[i] = full_drho;
+    ref.full_a_scale[i] = full_scale;
+    ref.full_drho_scale[i] = full_drho_scale;
     if (ref.a[i].norm() > 0.0) ref.dt_force = std::min(ref.dt_force, up * std::sqrt(s.h[i] / ref.a[i].norm()));
     // The acoustic length (core/sweep.hpp, AcousticLimit): h_i, or where shorter, with the last-rate predictor
     // kappa(h_i / d_i) rho_i / sum_j m_j |grad W_ij| (kernel.hpp), with the extrapolated one the length at which
@@ -179,6 +197,10 @@ void expect_rates_match_brute_force(const ParticleStore<D>& s, const sph::SweepL
     EXPECT_LE((s.a[i] - ref.a[i]).norm(), 1e-12 * up * ref.a_scale[i] + 1e-300) << what << ": a of " << i;
     EXPECT_LE(std::abs(s.drho[i] - ref.drho[i]), 1e-12 * up * ref.drho_scale[i] + 1e-300)
         << what << ": drho of " << i;
+    // The rates at full weight, against the same sums of term magnitudes at weight 1 (the same reasoning).
+    EXPECT_LE((s.full_a[i] - ref.full_a[i]).norm(), 1e-12 * ref.full_a_scale[i] + 1e-300) << what << ": full_a of " << i;
+    EXPECT_LE(std::abs(s.full_drho[i] - ref.full_drho[i]), 1e-12 * ref.full_drho_scale[i] + 1e-300)
+        << what << ": full_drho of " << i;
   }
   EXPECT_GT(checked, act.active_bin == 0 ? 100u : 20u);
   EXPECT_EQ(lim.pairs, ref.pairs) << what;
