@@ -45,6 +45,7 @@ Simulation make_still_tank(const TankSpec& spec) {
   s.geometry.container = {Vec<2>(0, 0), Vec<2>(spec.width, 2.0 * spec.depth)};
   s.ghost_pressure = spec.ghost_pressure;
   if (spec.density_diffusion) s.density_diffusion = DensityDiffusionSettings{0.1};
+  s.stepping = spec.stepping;
   if (spec.lennard_jones) s.lennard_jones = LennardJonesSettings{5.0 * kG * spec.depth, 0.5, spec.spacing / 2};
   Simulation sim(s);
   add_lattice(sim, lattice_rectangle(Vec<2>(0, 0), Vec<2>(spec.width, spec.depth), spec.spacing), spec.spacing,

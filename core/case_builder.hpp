@@ -21,6 +21,7 @@ struct TankSpec {
   bool lennard_jones = false;
   GhostPressure ghost_pressure = GhostPressure::hydrostatic;
   bool density_diffusion = false;  // delta-SPH (delta = 0.1) with the hydrostatic correction
+  TimeStepping stepping = TimeStepping::global;  // SolverSettings::stepping
 };
 
 /// Still water in a 3D box tank (open top, hydrostatic start, free-slip ghost walls on the floor and four sides).

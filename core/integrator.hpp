@@ -137,9 +137,12 @@ class Integrator {
   /// level). Those mark their neighbours, and only a marked particle walks its neighbourhood; every other keeps
   /// its own bin, which walking would give it too. So the result is that of walking every particle's neighbours,
   /// and does not depend on the order or the threads (a mark is a set bit).
+  /// With `own_level` (buffered levels, whose particles pair only within their level: core/sweep.hpp) the
+  /// neighbourhood is i's own level's.
   template <int D>
   void neighbourhood_bins(const ParticleView<D>& s, const CellGrid<D>& grid, double dt0, double cfl,
-                          NeighbourhoodWork& work) const {
+                          NeighbourhoodWork& work, bool own_level = false) const {
+    const auto pairs = [&](std::size_t i, std::size_t j) { return !own_level || s.level[i] == s.level[j]; };
     // Each fluid particle's bin from its own limit, and the largest pace a neighbour could move it a bin below.
     const double threshold = par::reduce(
         s.n, 0.0,
@@ -163,8 +166,10 @@ class Integrator {
     if (work.fast.empty()) return;
     work.near_fast.assign(s.n, 0);
     par::parallel_for(work.fast.size(), [&](std::size_t k) {
-      grid.for_each_neighbour(work.fast[k], s.x, s.h, [&](std::uint32_t i, double) {
-        if (s.kind[i] == Kind::fluid) std::atomic_ref<std::uint8_t>(work.near_fast[i]).store(1, std::memory_order_relaxed);
+      const std::uint32_t j = work.fast[k];
+      grid.for_each_neighbour(j, s.x, s.h, [&](std::uint32_t i, double) {
+        if (s.kind[i] == Kind::fluid && pairs(i, j))
+          std::atomic_ref<std::uint8_t>(work.near_fast[i]).store(1, std::memory_order_relaxed);
       });
     });
     par::parallel_for(s.n, [&](std::size_t i) {
@@ -172,7 +177,8 @@ class Integrator {
       double m = s.dt_limit[i];
       if (!(m > 0.0)) return;
       grid.for_each_neighbour(i, s.x, s.h, [&](std::size_t j, double) {
-        if (s.kind[j] != Kind::wall && s.dt_limit[j] > 0.0) m = std::min(m, s.dt_limit[j] * (s.h[i] / s.h[j]));
+        if (s.kind[j] != Kind::wall && s.dt_limit[j] > 0.0 && pairs(i, j))
+          m = std::min(m, s.dt_limit[j] * (s.h[i] / s.h[j]));
       });
       s.next_bin[i] = bin_for(s, i, dt0, cfl, m);
     });
@@ -194,8 +200,10 @@ class Integrator {
   /// its candidate runs (the store ranges the grid scans for it, a superset of its neighbours), in constant time a
   /// run (par::RangeMax); only the runs whose largest is more than bin_jump above its own are walked. The result
   /// is the same as walking every particle's neighbours; most particles, in a region of one bin, skip the walk.
+  /// With `own_level` (buffered levels) only neighbours of i's own level count, the only ones it pairs with.
   template <int D>
-  bool limit_bins(const ParticleView<D>& s, const CellGrid<D>& grid, BinLimiterWork& work) const {
+  bool limit_bins(const ParticleView<D>& s, const CellGrid<D>& grid, BinLimiterWork& work, bool own_level = false) const {
+    const auto pairs = [&](std::size_t i, std::size_t j) { return !own_level || s.level[i] == s.level[j]; };
     static_assert(kBinCount <= 127, "next bins are held as int8 in the range table");
     std::vector<std::int32_t>& raised = work.raised;
     raised.resize(s.n);
@@ -216,7 +224,8 @@ class Integrator {
             return e > b && work.reach.max(b, e) - bin_jump_ > s.next_bin[i];
           };
           grid.for_each_neighbour_in(i, s.x, s.h, walk, [&](std::size_t j, double) {
-            if (s.kind[j] == Kind::fluid || s.kind[j] == Kind::halo) need = std::max(need, s.next_bin[j] - bin_jump_);
+            if ((s.kind[j] == Kind::fluid || s.kind[j] == Kind::halo) && pairs(i, j))
+              need = std::max(need, s.next_bin[j] - bin_jump_);
           });
           raised[i] = std::min<std::int32_t>(need, bin_cap());
           return raised[i] != s.next_bin[i];

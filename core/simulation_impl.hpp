@@ -294,7 +294,7 @@ bool SimulationT<D>::choose_bins(bool neighbourhoods) {
   }
   const double dt0 = candidate[best];
   if (neighbourhoods) {
-    integ.neighbourhood_bins(s, grid_, dt0, cfl, neighbourhood_work_);
+    integ.neighbourhood_bins(s, grid_, dt0, cfl, neighbourhood_work_, buffered());
   } else {
     par::parallel_for(s.n, [&](std::size_t i) {
       if (s.kind[i] == Kind::fluid) s.next_bin[i] = integ.bin_for(s, i, dt0, cfl);
@@ -347,7 +347,7 @@ bool SimulationT<D>::limit_bins() {
   if (span[1] - span[0] <= integ.bin_jump()) return false;
   bool raised = false;
   for (;;) {
-    bool changed = integ.limit_bins(store_.view(), grid_, bin_limiter_);
+    bool changed = integ.limit_bins(store_.view(), grid_, bin_limiter_, buffered());
     if (domain_) changed = domain_->comm().any(changed);
     if (!changed) break;
     raised = true;

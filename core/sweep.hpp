@@ -124,13 +124,15 @@ class PairSweep {
     // lists of due particles) carries no per-pair bin look-ups, due tests or second sums. In six alternating pairs
     // the 2D pressure sweep at 1e5 took a median 25.5 ms against 31.6 ms in the shared loop (docs/PERFORMANCE.md,
     // 2026-12-03). Where they overlap the loops give the same bits: with bin_cap 0 every weight is 1.
-    // Own level only (buffered levels) runs with one global step only (the scene refuses per-level steps with it).
+    // Own level only (buffered levels): the same three loops, each with the pairs of other levels skipped.
+    const bool binned = act.bin_cap > 0 || act.active_bin > 0 || act.due_prefix != nullptr;
     if (act.own_level_only) {
-      if (act.bin_cap > 0 || act.active_bin > 0) throw std::logic_error("PairSweep: own-level pairs with time bins");
+      if (act.rebin) return sweep<true, true, true>(s, grid, act);
+      if (binned) return sweep<true, false, true>(s, grid, act);
       return sweep<false, false, true>(s, grid, act);
     }
     if (act.rebin) return sweep<true, true>(s, grid, act);
-    if (act.bin_cap > 0 || act.active_bin > 0 || act.due_prefix != nullptr) return sweep<true, false>(s, grid, act);
+    if (binned) return sweep<true, false>(s, grid, act);
     return sweep<false, false>(s, grid, act);
   }
 
@@ -140,7 +142,6 @@ class PairSweep {
   template <bool Binned, bool Rebin, bool OwnLevel = false>
   SweepLimits sweep(ParticleView<D> s, const CellGrid<D>& grid, const Activity& act) const {
     static_assert(Binned || !Rebin, "a rebin sweep reads the bins");
-    static_assert(!(Binned && OwnLevel), "buffered levels step with one global step");
     using Kernel = CubicSpline<D>;
     constexpr bool has_wall_effects = std::tuple_size_v<WallEffects> > 0;
     const double inf = std::numeric_limits<double>::infinity();
@@ -154,6 +155,13 @@ class PairSweep {
             s.drho[i] = 0.0;
             s.kick[i].setZero();
             s.kick_rho[i] = 0.0;
+            // A passive particle has no limit of its own: its bin is its level's (Integrator::bin_for with no limit),
+            // and it sets neither the coarse step nor a neighbour's bin. (Ghosts keep the limit copied from their
+            // source, which the neighbourhood bins read.)
+            if (s.kind[i] == Kind::fluid) {
+              s.dt_limit[i] = 0.0;
+              s.stiffness[i] = 1.0;
+            }
             return lim;
           }
           const int bi = Binned ? act.bin(s.bin[i]) : 0;

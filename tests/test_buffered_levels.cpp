@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/case_builder.hpp"
+#include "core/integrator.hpp"
 #include "core/refinement/buffer.hpp"
 #include "core/refinement/refinement_stage.hpp"
 #include "core/scene/runner.hpp"
@@ -52,6 +53,28 @@ TEST(BufferedLevels, SweepPairsOnlyWithinALevelAsTheBruteForceDoes) {
   sph::test::expect_rates_match_brute_force(s, lim, st, "own level only", act);
   // The twin is sharp: dropping the other level's pairs changes most rates beyond the comparison's tolerance.
   EXPECT_GT(sph::test::changed_accelerations(brute_force(s, st, act), brute_force(s, st, Activity{})), 100u);
+  // Per-level steps (each level in its own bin): the binned loop at each active bin, and the rebin evaluation of a
+  // step after which some particles change bin, against the same twin.
+  for (std::size_t i = 0; i < s.size(); ++i) s.bin[i] = s.next_bin[i] = s.level[i];
+  for (const int active : {1, 0}) {
+    SCOPED_TRACE(testing::Message() << "active bin " << active);
+    Activity binned{active, Integrator::kMaxBin};
+    binned.own_level_only = true;
+    const SweepLimits b = make_sweep(st)->run(s.view(), grid, binned);
+    sph::test::expect_rates_match_brute_force(s, b, st, "own level only, bins", binned);
+  }
+  std::size_t moved = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] != Kind::fluid || i % 5 != 0) continue;
+    s.next_bin[i] = s.level[i] + 1;
+    ++moved;
+  }
+  ASSERT_GT(moved, 20u);
+  Activity rebin{0, Integrator::kMaxBin};
+  rebin.own_level_only = true;
+  rebin.rebin = true;
+  const SweepLimits r = make_sweep(st)->run(s.view(), grid, rebin);
+  sph::test::expect_rates_match_brute_force(s, r, st, "own level only, rebin", rebin);
 }
 
 /// The fit of core/refinement/buffer.hpp written out directly: every particle of the store, the weighted least-squares
@@ -334,10 +357,14 @@ struct TankRun {
   double e0 = 0.0;
   std::size_t outside = 0;
   std::size_t passes = 0;
+  int coarse_bin = -1;  // the finest time bin of an active level-0 particle at the end
+  int fine_bin = -1;    // the coarsest time bin of an active particle of the finest level at the end
 };
 
-TankRun run_tank(const refine::RefinementSettings* r, double end) {
-  Simulation sim = make_still_tank(TankSpec{});
+TankRun run_tank(const refine::RefinementSettings* r, double end, TimeStepping stepping) {
+  TankSpec spec;
+  spec.stepping = stepping;
+  Simulation sim = make_still_tank(spec);
   if (r != nullptr) refine::add_refinement_stage(sim, *r);
   TankRun out;
   out.e0 = sim.diagnostics().total_energy();
@@ -362,8 +389,13 @@ TankRun run_tank(const refine::RefinementSettings* r, double end) {
   out.window_speed = speed_sum / static_cast<double>(std::max<std::size_t>(speed_steps, 1));
   out.fluid_end = sim.diagnostics().fluid;
   const auto& s = sim.store();
+  const int finest = r != nullptr ? r->max_level : 0;
   for (std::size_t i = 0; i < s.size(); ++i) {
-    if (s.kind[i] == Kind::fluid && !sim.settings().geometry.in_fluid_domain(s.x[i])) ++out.outside;
+    if (s.kind[i] != Kind::fluid) continue;
+    if (!sim.settings().geometry.in_fluid_domain(s.x[i])) ++out.outside;
+    if (is_passive(s.role[i])) continue;
+    if (s.level[i] == 0) out.coarse_bin = std::max(out.coarse_bin, s.bin[i]);
+    if (s.level[i] == finest) out.fine_bin = out.fine_bin < 0 ? s.bin[i] : std::min(out.fine_bin, s.bin[i]);
   }
   return out;
 }
@@ -373,6 +405,7 @@ struct TankCase {
   Vec<2> lo, hi;
   refine::Pattern pattern;
   int levels;
+  TimeStepping stepping = TimeStepping::global;
 };
 
 class BufferedStillTank : public ::testing::TestWithParam<TankCase> {};
@@ -393,8 +426,8 @@ TEST_P(BufferedStillTank, StaysAsStillAsTheUnrefinedTank) {
   r.check_interval = 100;
   r.max_level = c.levels;
   r.coupling = LevelCoupling::buffered;
-  const TankRun plain = run_tank(nullptr, end);
-  const TankRun refined = run_tank(&r, end);
+  const TankRun plain = run_tank(nullptr, end, c.stepping);
+  const TankRun refined = run_tank(&r, end, c.stepping);
   RecordProperty("window_speed_over_unrefined", std::to_string(refined.window_speed / plain.window_speed));
   EXPECT_EQ(refined.passes, static_cast<std::size_t>(c.levels));
   EXPECT_LE(refined.window_speed, 2.0 * plain.window_speed) << "unrefined " << plain.window_speed;
@@ -402,13 +435,24 @@ TEST_P(BufferedStillTank, StaysAsStillAsTheUnrefinedTank) {
   EXPECT_GT(refined.fluid_after_last, plain.fluid_end);
   EXPECT_EQ(refined.outside, 0u);
   EXPECT_LE(refined.largest_pass_change, 1e-6 * refined.e0);
+  if (c.stepping == TimeStepping::per_level) {  // the levels did step in bins of their own, the finest the finer
+    EXPECT_GE(refined.coarse_bin, 0);
+    EXPECT_LT(refined.coarse_bin, refined.fine_bin);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Zones, BufferedStillTank,
                          ::testing::Values(TankCase{"bulk_aap_1", Vec<2>(10, 3), Vec<2>(15, 7), refine::Pattern::aap, 1},
                                            TankCase{"wall_rsp_1", Vec<2>(0, 3), Vec<2>(4, 7), refine::Pattern::rsp, 1},
                                            TankCase{"wall_rsp_2", Vec<2>(0, 3), Vec<2>(4, 7), refine::Pattern::rsp, 2},
-                                           TankCase{"corner_rsp_2", Vec<2>(0, 0), Vec<2>(5, 4), refine::Pattern::rsp, 2}),
+                                           TankCase{"corner_rsp_2", Vec<2>(0, 0), Vec<2>(5, 4), refine::Pattern::rsp, 2},
+                                           // Issue #16's "two levels in their own bins stay at rest": each level
+                                           // steps in its own bin (buffered levels pair within a level only, so
+                                           // the limiter and the neighbourhood limit look at the own level).
+                                           TankCase{"bulk_aap_2_per_level", Vec<2>(10, 3), Vec<2>(15, 7),
+                                                    refine::Pattern::aap, 2, TimeStepping::per_level},
+                                           TankCase{"corner_rsp_2_per_level", Vec<2>(0, 0), Vec<2>(5, 4),
+                                                    refine::Pattern::rsp, 2, TimeStepping::per_level}),
                          [](const auto& p) { return std::string(p.param.name); });
 
 /// tie_buffers against the brute force: after the hosts move (each by its own displacement), every buffer particle
@@ -496,8 +540,11 @@ INSTANTIATE_TEST_SUITE_P(
                       FlowCase{"velocity", "effects.refinement.coupling=buffered"}),
     [](const auto& p) { return std::string(p.param.name); });
 
-/// The same bits at one and two threads: the flips, the band and the fit do not depend on the threads' shares.
-TEST(BufferedLevels, StillTankIsBitwiseTheSameAtOneAndTwoThreads) {
+/// The same bits at one and two threads, with one global step and per level: the flips, the band, the fit and the
+/// bins do not depend on the threads' shares.
+class BufferedThreads : public ::testing::TestWithParam<TimeStepping> {};
+
+TEST_P(BufferedThreads, StillTankIsBitwiseTheSameAtOneAndTwoThreads) {
   refine::RefinementSettings r;
   r.criterion = refine::CriterionKind::zone;
   r.zone = Box2{Vec<2>(0, 0), Vec<2>(5, 4)};
@@ -509,7 +556,9 @@ TEST(BufferedLevels, StillTankIsBitwiseTheSameAtOneAndTwoThreads) {
   std::vector<ParticleStore<2>> ends;
   for (const int t : {1, 2}) {
     omp_set_num_threads(t);
-    Simulation sim = make_still_tank(TankSpec{});
+    TankSpec spec;
+    spec.stepping = GetParam();
+    Simulation sim = make_still_tank(spec);
     refine::add_refinement_stage(sim, r);
     for (int k = 0; k < 220; ++k) {
       sim.step();
@@ -530,5 +579,8 @@ TEST(BufferedLevels, StillTankIsBitwiseTheSameAtOneAndTwoThreads) {
   }
   EXPECT_GT(passive, 50u);
 }
+
+INSTANTIATE_TEST_SUITE_P(Stepping, BufferedThreads, ::testing::Values(TimeStepping::global, TimeStepping::per_level),
+                         [](const auto& p) { return std::string(p.param == TimeStepping::global ? "global" : "per_level"); });
 
 }  // namespace

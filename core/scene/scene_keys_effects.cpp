@@ -160,7 +160,7 @@ const S<Refinement>& refinement_section() {
               .means("families merge back where the flow no longer needs them"));
     d.add(value<Refinement>("coupling", member(&Refinement::coupling))
               .only_for({"zone", "velocity"})
-              .note("`buffered`: 2D, one process, `time.stepping` global, no coarsening or static refinement, every fluid "
+              .note("`buffered`: 2D, one process, no coarsening or static refinement, every fluid "
                     "region at one level; fine fluid that leaves the zone stays fine, and coarse fluid it mixes with is "
                     "refined")
               .means("how levels interact: every pair (`mixed`, the paper's), or each level with its own, its lattice "

@@ -195,16 +195,11 @@ void validate_scene(const Scene& s) {
     const std::string p = "effects.refinement";
     if (r.criterion == Criterion::zone) valid_rect(r.zone, p + ".zone");
     if (r.coupling == LevelCoupling::buffered) {
-      // What buffered levels do not handle yet (docs/METHOD.md, "Buffered levels"): passive particles are fitted once
-      // per step for every particle, and a family is never taken back.
+      // What buffered levels do not handle yet (docs/METHOD.md, "Buffered levels"): a family is never taken back.
       if (r.coarsening) fail(p + ".coupling", "\"buffered\" does not coarsen yet; remove effects.refinement.coarsening or use \"mixed\"");
       if (dimension(s) == 3) {
         fail(p + ".coupling", "\"buffered\" is 2D only so far: the 3D still tank with a buffered zone is not yet still "
                               "(docs/METHOD.md, \"Buffered levels\"); use \"mixed\"");
-      }
-      if (s.time.stepping != TimeStepping::global) {
-        fail(p + ".coupling", "\"buffered\" needs time.stepping \"global\" (passive particles are fitted at every "
-                              "evaluation of every particle); use \"mixed\" for per-level steps");
       }
       // No pair mixes levels, so particles of different levels that no split made (a static refinement, fluid regions
       // set up at other levels) would not meet at all: they have no shadows or buffer particles between them.
