@@ -197,23 +197,32 @@ class ParticleStore {
     gather(src.size(), [from](std::size_t k) { return from[k]; });
   }
 
-  /// Sizes this store as `other` (and takes its next id) for copy_particle(); no allocation once sizes settle.
+  /// Sizes this store as `other` (and takes its next id) for a copy; no allocation once sizes settle.
   void prepare_copy_of(const ParticleStore& other) {
     const std::size_t n = other.size();
     for_each_field([n](auto& f) { f.values().resize(n); });
     next_id_ = other.next_id_;
   }
-  /// Particle i := other's particle i, every field. After prepare_copy_of(other); safe from any thread for
-  /// distinct i, so a copy can ride in another loop over the particles instead of a region of its own.
-  void copy_particle(const ParticleStore& other, std::size_t i) {
-    for_each_field_with(other, [i](auto& mine, const auto& theirs) { mine[i] = theirs[i]; });
-  }
-
   /// This store := a copy of `other`'s particles (values and next id; the scratch buffers are not copied).
-  /// Reuses this store's capacity: no allocation once sizes settle.
+  /// Reuses this store's capacity: no allocation once sizes settle. Field by field, each a contiguous copy (one
+  /// stream read and one written at a time), all fields in one parallel region as gather() has them.
   void assign_from(const ParticleStore& other) {
     prepare_copy_of(other);
-    par::parallel_for(other.size(), [&](std::size_t i) { copy_particle(other, i); });
+    const auto count = static_cast<std::ptrdiff_t>(other.size());
+    const auto fields = [&] {
+      for_each_field_with(other, [&](auto& mine, const auto& theirs) {
+        auto* out = mine.data();
+        const auto* in = theirs.data();
+#pragma omp for schedule(static) nowait
+        for (std::ptrdiff_t k = 0; k < count; ++k) out[k] = in[k];
+      });
+    };
+    if (par::serial(other.size())) {
+      fields();
+    } else {
+#pragma omp parallel
+      fields();
+    }
   }
 
   /// Keeps the particles with keep(i), in order.

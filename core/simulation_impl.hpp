@@ -415,15 +415,15 @@ StepInfo SimulationT<D>::step(double dt_cap) {
   const double tau = std::ldexp(dt, -finest);
   std::string step_error;
   if (watch) {
-    last_good_.prepare_copy_of(store_);  // reuses capacity: no allocation once the sizes are stable
+    last_good_.assign_from(store_);  // reuses capacity: no allocation once the sizes are stable
     last_good_limits_ = limits_;
     last_good_removed_ = removed_;
   }
   SweepLimits step_limits;
   for (int k = 1; k <= substeps && step_error.empty(); ++k) {
-    // One parallel region for the rollback copy and the opening kick (first substep) or the previous
-    // substep's kick, the drift and prediction, and the first pass of the neighbour preparation (each
-    // particle's output count and the smoothing-length range): all per particle.
+    // One parallel region for the opening kick (first substep) or the previous substep's kick, the drift and
+    // prediction, and the first pass of the neighbour preparation (each particle's output count and the
+    // smoothing-length range): all per particle.
     SmoothingRange hr;
     {
       auto s = store_.view();
@@ -431,7 +431,6 @@ StepInfo SimulationT<D>::step(double dt_cap) {
       hr = par::accumulate(
           s.n, SmoothingRange{},
           [&](SmoothingRange& r, std::size_t i) {
-            if (k == 1 && watch) last_good_.copy_particle(store_, i);
             if (s.kind[i] == Kind::fluid && is_passive(s.role[i])) {
               integ.carry(s, i, tau);
             } else if (s.kind[i] == Kind::fluid) {
