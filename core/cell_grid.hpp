@@ -258,17 +258,26 @@ class CellGrid {
   /// tell from a run's range (a range table over the store order) that none of its particles matters.
   template <class Walk, class F>
   void for_each_neighbour_in(std::size_t i, const VecD* x, const double* h, Walk&& walk, F&& f) const {
+    for_each_neighbour_in_layers(i, x, h, [](std::uint32_t, std::uint32_t) { return true; }, walk, f);
+  }
+  /// for_each_neighbour_in, in the layers for which keep(begin, end) holds, given the layer's particle range.
+  template <class Keep, class Walk, class F>
+  void for_each_neighbour_in_layers(std::size_t i, const VecD* x, const double* h, Keep&& keep, Walk&& walk,
+                                    F&& f) const {
     const VecD xi = x[i];
     const double hi = h[i];
-    for_each_support_run(xi, hi, [&](std::uint32_t b, std::uint32_t e) {
-      if (!walk(b, e)) return;
-      for (std::uint32_t j = b; j < e; ++j) {
-        if (j == i) continue;
-        const double r2 = (xi - x[j]).squaredNorm();
-        const double support = hi + h[j];
-        if (r2 < support * support) f(j, r2);
-      }
-    });
+    for_each_support_run(
+        xi, hi,
+        [&](std::uint32_t b, std::uint32_t e) {
+          if (!walk(b, e)) return;
+          for (std::uint32_t j = b; j < e; ++j) {
+            if (j == i) continue;
+            const double r2 = (xi - x[j]).squaredNorm();
+            const double support = hi + h[j];
+            if (r2 < support * support) f(j, r2);
+          }
+        },
+        keep);
   }
 
  private:

@@ -136,7 +136,11 @@ BruteFit brute_fit(const ParticleStore<2>& s, std::size_t i) {
   return f;
 }
 
-TEST(BufferedLevels, PassiveFitEqualsTheBruteForceFitAndIsExactForLinearFields) {
+// On one grid, and on the solver's grid with a layer per level, where the fit skips its own level's layer.
+class PassiveFit : public ::testing::TestWithParam<bool> {};
+
+TEST_P(PassiveFit, EqualsTheBruteForceFitAndIsExactForLinearFields) {
+  const bool layered = GetParam();
   const SolverSettings st = twin_settings(true, false);
   ParticleStore<2> s = twin_cloud(st, 7);
   make_some_passive(s);
@@ -148,7 +152,12 @@ TEST(BufferedLevels, PassiveFitEqualsTheBruteForceFitAndIsExactForLinearFields) 
     s.v[i] = v_at(s.x[i]);
   }
   CellGrid<2> grid;
-  sph::test::build_grid(s, grid);
+  if (layered) {
+    sph::test::build_level_grid_in_order(s, grid);
+    ASSERT_GT(grid.layer_count(), 1);
+  } else {
+    sph::test::build_grid(s, grid);
+  }
   std::vector<BruteFit> expected(s.size());
   for (std::size_t i = 0; i < s.size(); ++i) {
     if (s.kind[i] == Kind::fluid && is_passive(s.role[i])) expected[i] = brute_fit(s, i);
@@ -180,6 +189,9 @@ TEST(BufferedLevels, PassiveFitEqualsTheBruteForceFitAndIsExactForLinearFields) 
   EXPECT_LT(held, checked / 10) << "the cloud's passive particles lie mostly among their sources";
   RecordProperty("held_by_the_bound", std::to_string(held));
 }
+
+INSTANTIATE_TEST_SUITE_P(Grids, PassiveFit, ::testing::Bool(),
+                         [](const auto& p) { return std::string(p.param ? "a_layer_per_level" : "one_grid"); });
 
 /// One passive particle of level `passive_level` (smoothing length h) at x among the active particles of level
 /// `source_level`, on a lattice of spacing d offset by d / 4 in each axis as a split's daughters are (h = 1.2 d), that

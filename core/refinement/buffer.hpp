@@ -97,14 +97,20 @@ bool fit_passive(const ParticleView<D>& s, std::size_t i, Neighbours&& for_each_
 /// Every passive fluid particle's v, rho (and p, and the half-step copies vh, rhoh) from its fit (fit_passive), on
 /// the grid built for the store as it is: once before each evaluation (Simulation::step, Simulation::refresh), so
 /// the active particles meet the other levels' state as predicted for it. A passive particle with no source in reach
-/// keeps its values.
+/// keeps its values. The grid has one layer, or one per level as the solver builds it (build_level_grid: layer l
+/// holds level l alone for l < kGridLayers - 1); in the latter the fit skips its own level's layer, which holds no
+/// source (the same sources in the same order, so the same bits, with fewer candidates).
 template <int D>
 void interpolate_passive(const ParticleView<D>& s, const CellGrid<D>& grid, const TaitEquationOfState& eos) {
+  const bool layered = grid.layer_count() > 1;
   par::parallel_for(s.n, [&](std::size_t i) {
     if (s.kind[i] != Kind::fluid || !is_passive(s.role[i])) return;
     double rho = 0.0;
     Vec<D> v = Vec<D>::Zero();
-    const auto neighbours = [&](auto&& f) { grid.for_each_neighbour(i, s.x, s.h, f); };
+    const bool skip_own = layered && s.level[i] < kGridLayers - 1;
+    const auto other_layers = [&](std::uint32_t b, std::uint32_t e) { return !(skip_own && b <= i && i < e); };
+    const auto every_run = [](std::uint32_t, std::uint32_t) { return true; };
+    const auto neighbours = [&](auto&& f) { grid.for_each_neighbour_in_layers(i, s.x, s.h, other_layers, every_run, f); };
     if (!fit_passive(s, i, neighbours, rho, v)) return;
     s.rho[i] = rho;
     s.v[i] = v;
