@@ -311,7 +311,7 @@ class Integrator {
       return;
     }
     const int period = 1 << (finest - bin(s.bin[i]));
-    if (k % period == 0) {
+    if (period > 1 && k % period == 0) {  // (a step of one substep never predicts inside itself: open() likewise)
       s.v_open[i] = s.vh[i] + half * s.kick[i];
       s.rho_open[i] = s.rhoh[i] + half * s.kick_rho[i];
     }
