@@ -1,0 +1,69 @@
+#!/usr/bin/python3
+"""Whether the dam break with a buffered zone completes when nothing that matters changes: the check interval one
+step either side of 100, and the Courant number 0.19. Also what its energy does: the largest rise of the total
+energy between output rows (a fraction of E(0); the fully refined run only ever loses energy between rows), the largest speed and the largest density error. docs/METHOD.md, "Buffered levels".
+
+    /usr/bin/python3 tools/buffered_robustness.py [--app build/release/app/sphrefine] [--jobs 2]
+
+Each run: cases/dam_break_aap.json, one thread, a zone criterion with one level, coupling "buffered". Prints one
+markdown row per zone, pattern and perturbation.
+"""
+import argparse
+import csv
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+from concurrent.futures import ThreadPoolExecutor
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# The zones of docs/METHOD.md's tables: the right-hand corner, the column's foot, the floor ahead of it, a block
+# through which the whole surge passes.
+ZONES = [((44, 0), (50, 6)), ((0, 0), (8, 8)), ((20, 0), (30, 5)), ((10, 0), (20, 10))]
+# (check_interval, cfl): the settings of the tables, then one step either side, then a Courant number 5 % lower.
+PERTURBATIONS = [(100, 0.2), (99, 0.2), (101, 0.2), (100, 0.19)]
+
+
+def run(app, coupling, zone, pattern, interval, cfl, out):
+    refinement = {"criterion": "zone", "zone": {"lo": list(zone[0]), "hi": list(zone[1])}, "pattern": pattern,
+                  "check_interval": interval, "max_level": 1, "coupling": coupling}
+    cmd = [app, "run", os.path.join(ROOT, "cases", "dam_break_aap.json"), "-o", out, "--force", "-q", "--threads",
+           "1", "--set", f"time.cfl={cfl}", "--set", "effects.refinement=" + json.dumps(refinement)]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    stop = re.search(r"stopped at step \d+, t = ([0-9.]+) s", r.stderr + r.stdout)
+    if r.returncode != 0 and not stop:
+        sys.exit(f"{' '.join(cmd)} failed: {r.stderr.strip()}")
+    with open(os.path.join(out, "series.csv")) as f:
+        rows = list(csv.DictReader(f))
+    energy = [float(row["total_energy"]) for row in rows]
+    rise = max(b - a for a, b in zip(energy, energy[1:])) / abs(energy[0])
+    return {"status": f"stopped at {float(stop.group(1)):.2f} s" if stop else "completes",
+            "rise": rise,
+            "speed": max(float(row["max_speed"]) for row in rows),
+            "density": max(float(row["max_density_error"]) for row in rows)}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--app", default=os.path.join(ROOT, "build", "release", "app", "sphrefine"))
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--patterns", default="aap,rsp")
+    ap.add_argument("--coupling", default="buffered", choices=["buffered", "mixed"])
+    args = ap.parse_args()
+    if not os.access(args.app, os.X_OK):
+        sys.exit(f"--app {args.app}: not an executable")
+    jobs = [(z, p, i, c) for z in ZONES for p in args.patterns.split(",") for i, c in PERTURBATIONS]
+    with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(args.jobs) as pool:
+        results = list(pool.map(lambda jk: run(args.app, args.coupling, *jk[1], os.path.join(tmp, str(jk[0]))), enumerate(jobs)))
+    print("| zone | pattern | check interval | C | run | largest energy rise between rows / E(0) | max speed (m/s) "
+          "| max density error |")
+    print("|---|---|---|---|---|---|---|---|")
+    for (z, p, i, c), r in zip(jobs, results):
+        print(f"| `[{z[0][0]},{z[1][0]}] x [{z[0][1]},{z[1][1]}]` | {p.upper()} | {i} | {c} | {r['status']} "
+              f"| {r['rise']:.1e} | {r['speed']:.0f} | {r['density']:.2f} |")
+
+
+if __name__ == "__main__":
+    main()
