@@ -1,12 +1,15 @@
 #!/usr/bin/python3
-"""Whether the dam break with a buffered zone completes when nothing that matters changes: the check interval one
-step either side of 100, and the Courant number 0.19. Also what its energy does: the largest rise of the total
-energy between output rows (a fraction of E(0); the fully refined run only ever loses energy between rows), the largest speed and the largest density error. docs/METHOD.md, "Buffered levels".
+"""Whether the dam break with a refined zone completes when nothing that matters changes: the check interval one
+step either side of 100, and the Courant number 0.19; and what its energy does: the largest rise of the total energy
+between output rows (a fraction of E(0); the fully refined run only ever loses energy between rows), the largest
+speed and the largest density error. Buffered levels, and the paper's mixed pairs on the same runs for comparison.
+docs/METHOD.md, "Buffered flows under small changes", holds the summary table this prints last.
 
     /usr/bin/python3 tools/buffered_robustness.py [--app build/release/app/sphrefine] [--jobs 2]
+                                                  [--couplings buffered,mixed] [--patterns aap,rsp]
 
-Each run: cases/dam_break_aap.json, one thread, a zone criterion with one level, coupling "buffered". Prints one
-markdown row per zone, pattern and perturbation.
+Each run: cases/dam_break_aap.json, one thread, a zone criterion with one level. Prints one markdown row per
+coupling, zone, pattern and perturbation, then one row per zone and pattern with the couplings side by side.
 """
 import argparse
 import csv
@@ -45,24 +48,51 @@ def run(app, coupling, zone, pattern, interval, cfl, out):
             "density": max(float(row["max_density_error"]) for row in rows)}
 
 
+def summary(rows):
+    """(runs that complete, with the stop times; largest rise; largest speed; largest density error) of a zone's runs."""
+    stops = [r["status"].replace("stopped at ", "") for r in rows if r["status"] != "completes"]
+    done = f"{len(rows) - len(stops)} of {len(rows)}" + (f" (stops at {', '.join(stops)})" if stops else "")
+    return (done, f"{max(r['rise'] for r in rows):.1e}", f"{max(r['speed'] for r in rows):.0f}",
+            f"{max(r['density'] for r in rows):.2f}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--app", default=os.path.join(ROOT, "build", "release", "app", "sphrefine"))
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--patterns", default="aap,rsp")
-    ap.add_argument("--coupling", default="buffered", choices=["buffered", "mixed"])
+    ap.add_argument("--couplings", default="buffered,mixed")
     args = ap.parse_args()
     if not os.access(args.app, os.X_OK):
         sys.exit(f"--app {args.app}: not an executable")
-    jobs = [(z, p, i, c) for z in ZONES for p in args.patterns.split(",") for i, c in PERTURBATIONS]
+    couplings = args.couplings.split(",")
+    for c in couplings:
+        if c not in ("buffered", "mixed"):
+            sys.exit(f"--couplings: unknown coupling {c!r} (buffered, mixed)")
+    patterns = args.patterns.split(",")
+    jobs = [(k, z, p, i, c) for k in couplings for z in ZONES for p in patterns for i, c in PERTURBATIONS]
     with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(args.jobs) as pool:
-        results = list(pool.map(lambda jk: run(args.app, args.coupling, *jk[1], os.path.join(tmp, str(jk[0]))), enumerate(jobs)))
-    print("| zone | pattern | check interval | C | run | largest energy rise between rows / E(0) | max speed (m/s) "
-          "| max density error |")
-    print("|---|---|---|---|---|---|---|---|")
-    for (z, p, i, c), r in zip(jobs, results):
-        print(f"| `[{z[0][0]},{z[1][0]}] x [{z[0][1]},{z[1][1]}]` | {p.upper()} | {i} | {c} | {r['status']} "
-              f"| {r['rise']:.1e} | {r['speed']:.0f} | {r['density']:.2f} |")
+        results = list(pool.map(lambda n_job: run(args.app, *n_job[1], os.path.join(tmp, str(n_job[0]))),
+                                enumerate(jobs)))
+    zone_text = lambda z: f"`[{z[0][0]},{z[1][0]}] x [{z[0][1]},{z[1][1]}]`"  # noqa: E731
+    print("| coupling | zone | pattern | check interval | C | run | largest energy rise between rows / E(0) "
+          "| max speed (m/s) | max density error |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for (k, z, p, i, c), r in zip(jobs, results):
+        print(f"| {k} | {zone_text(z)} | {p.upper()} | {i} | {c} | {r['status']} | {r['rise']:.1e} | {r['speed']:.0f} "
+              f"| {r['density']:.2f} |")
+    print()
+    head = "| zone | pattern |" + "".join(f" {k}: runs that complete | largest rise / E(0) | max speed (m/s) | max "
+                                         "density error |" for k in couplings)
+    print(head)
+    print("|---|---|" + "---|---|---|---|" * len(couplings))
+    for z in ZONES:
+        for p in patterns:
+            cells = []
+            for k in couplings:
+                rows = [r for (kk, zz, pp, _, _), r in zip(jobs, results) if (kk, zz, pp) == (k, z, p)]
+                cells += summary(rows)
+            print(f"| {zone_text(z)} | {p.upper()} | " + " | ".join(cells) + " |")
 
 
 if __name__ == "__main__":
