@@ -475,6 +475,13 @@ def table(rows, cols):
     return head + body
 
 
+ENERGY_NOTE = ("\n\"energy change\" is E(end) - E(0), and \"largest rise between rows\" the largest increase of E "
+               "between two output rows, both over |E(0)|, with E = kinetic + potential + elastic "
+               "(Diagnostics::total_energy). Viscosity, density diffusion and the walls only take energy out, so a rise "
+               "is energy that a refinement pass, the coupling of the levels or the time stepping put in: the fully "
+               "refined run's row shows what the time stepping alone does.\n")
+
+
 def summarise(case, runs, windows):
     """One row per variant: time, steps, counts, relative time, and each probe's error against the fully refined
     run of the same resolution (tools/local_quantities.py: RMS over the window where the reference has left its
@@ -493,6 +500,13 @@ def summarise(case, runs, windows):
                                          else "before the fix"),
                "mean_n": mean_n, "final_n": final_n,
                "mass_drift": r["summary"]["mass_drift"]}
+        # Total energy (kinetic + potential + elastic, Diagnostics::total_energy) relative to |E(0)|: its change
+        # over the run, and its largest rise between two output rows (viscosity, diffusion and the walls only take
+        # energy out: a rise is energy a pass, a coupling or the time stepping put in).
+        energy = np.asarray(s["total_energy"], dtype=float)
+        e0 = abs(energy[0]) if len(energy) and energy[0] != 0.0 else float("nan")
+        row["e_change"] = (energy[-1] - energy[0]) / e0 if len(energy) else float("nan")
+        row["e_rise"] = float(np.max(np.diff(energy))) / e0 if len(energy) > 1 else float("nan")
         failure = r["summary"].get("failure")
         row["status"] = ("stopped at t = %.3g s: %s" % (failure["time"], failure["quantity"])
                          if r["summary"].get("status") == "failed" and failure else "completed")
@@ -570,7 +584,9 @@ def findings_section(f):
             def pl_part(tag, label, g, l, rsp):
                 part = (f"{label}: AAP {100 * g['rel_time']:.0f} % -> {100 * l['rel_time']:.0f} % of the fully refined "
                         f"run's time, evaluations {100 * g['rel_psteps']:.0f} % -> {100 * l['rel_psteps']:.0f} %, RMS "
-                        + ", ".join(f"{p[4:]} {100 * g[p]:.1f} -> {100 * l[p]:.1f} %" for p in probes))
+                        + ", ".join(f"{p[4:]} {100 * g[p]:.1f} -> {100 * l[p]:.1f} %" for p in probes)
+                        + f", energy change {g['e_change']:.2e} -> {l['e_change']:.2e} E(0), largest rise between "
+                        f"rows {g['e_rise']:.1e} -> {l['e_rise']:.1e} E(0)")
                 if rsp:
                     part += (f"; RSP per level {100 * rsp['rel_time']:.0f} %" if rsp["status"] == "completed"
                              else "; RSP per level stopped early")
@@ -921,8 +937,11 @@ def main():
                                ("same, per-level steps (estimate)", lambda r: r["rel_psteps_own"]),
                                ("H: RMS / range vs refined", lambda r: r["rms_H"]),
                                ("Z: RMS / range vs refined", lambda r: r["rms_Z"]),
+                               ("energy change / E(0)", lambda r: r["e_change"]),
+                               ("largest rise between rows / E(0)", lambda r: r["e_rise"]),
                                ("mass drift", lambda r: r["mass_drift"]), ("status", lambda r: r["status"]),
                                ("timed", lambda r: r["timed"])]))
+        md.append(ENERGY_NOTE)
         md.append("\n\"time / refined\" and \"particle-steps / refined\" are the paper's measure: against the fully refined "
                   "run of the same finest resolution (refined, refined_x4, refined_x16). \"H: RMS / range\" and \"Z: "
                   "RMS / range\" are each probe's RMS difference from that run over a window, divided by the refined "
@@ -1018,8 +1037,11 @@ def main():
                                ("same, per-level steps (estimate)", lambda r: r["rel_psteps_own"]),
                                ("H: RMS / range vs refined", lambda r: r["rms_H"]),
                                ("H_left_wall: RMS / range vs refined", lambda r: r["rms_H_left_wall"]),
+                               ("energy change / E(0)", lambda r: r["e_change"]),
+                               ("largest rise between rows / E(0)", lambda r: r["e_rise"]),
                                ("mass drift", lambda r: r["mass_drift"]), ("status", lambda r: r["status"]),
                                ("timed", lambda r: r["timed"])]))
+        md.append(ENERGY_NOTE)
         md.append("\n\"time / refined\" and \"particle-steps / refined\" are the paper's measure, against the fully refined "
                   "run of the same finest resolution. \"H: RMS / range\" (the surface at the centre) and "
                   "\"H_left_wall: RMS / range\" are each probe's RMS difference from that run over a window, divided by "
