@@ -58,8 +58,10 @@ struct AnyVec : Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 3, 1> 
 enum class Kind : std::uint8_t { fluid = 0, wall = 1, ghost = 2, halo = 3 };
 
 /// How a particle took its level: at set-up, as a daughter of a split, or as the particle a merge made
-/// (`fresh_merge` until the refinement check after that merge, which does not split it, then `merge`).
-enum class Origin : std::uint8_t { setup = 0, split = 1, fresh_merge = 2, merge = 3 };
+/// (`fresh_merge` until the refinement check after that merge, which does not split it, then `merge`; `fresh_split`
+/// until the check after the split that made it, or that made it active, at which its family does not merge, then
+/// `split`). No family flips between split and merge from one check to the next, whatever the cause of the split.
+enum class Origin : std::uint8_t { setup = 0, split = 1, fresh_merge = 2, merge = 3, fresh_split = 4 };
 
 /// effects.refinement.coupling: how particles of different levels interact. `mixed` (the paper's): every pair within
 /// reach, whatever the levels, with h_ij = (h_i + h_j) / 2. `buffered`: a particle's SPH sums take only particles of

@@ -21,6 +21,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -28,6 +29,7 @@
 #include "core/equation_of_state.hpp"
 #include "core/kernel.hpp"
 #include "core/particle_store.hpp"
+#include "core/refinement/merge_pass.hpp"
 #include "parallel/parallel_for.hpp"
 
 namespace sph::refine {
@@ -143,7 +145,8 @@ inline constexpr double kIntermixReach = 0.6;
 /// Turns the criterion's marks (1: refine) into a buffered pass's (split_marked with buffered = true), on the store
 /// between steps (fluid, ghosts dropped or not):
 ///   - an active particle of level l within kIntermixReach d_l of an active particle of level l + 1 is marked;
-///   - a marked host becomes a shadow and its buffer daughters active (its zone grew over it): no split;
+///   - a marked host becomes a shadow and its buffer daughters active (its zone grew over it; Origin::fresh_split):
+///     no split;
 ///   - a mark on a particle that is passive or already has daughters is dropped;
 ///   - an unmarked active or buffer particle of level l < max_level without daughters, within h_l + d_l (a daughter's
 ///     support 2 h_{l+1}, plus how far its own daughters sit from it) of an active particle of level l + 1, or within
@@ -152,5 +155,46 @@ inline constexpr double kIntermixReach = 0.6;
 /// Returns the number of hosts that became shadows. Deterministic: no mark depends on the store's order.
 template <int D>
 std::size_t prepare_buffered_marks(ParticleStore<D>& store, std::vector<std::uint8_t>& marks, int max_level);
+
+/// How far (beyond the reach h_l + d_l at which prepare_buffered_marks gives a particle of level l its buffer
+/// daughters) the finer level's active particles must have gone before a host gives its buffer daughters up
+/// (retract_buffered): the band is taken away only where no active particle of level l + 1 is within
+/// kUnbufferReach (h_l + d_l), so that a host does not flip between having a band and not from one check to the next.
+/// A particle moves at most about 0.02 h a step (dt <= C h / c0 with C = 0.2, speeds below c0 / 10 in a
+/// weakly-compressible flow), 2 h_{l+1} = h_l over a check interval of 100 steps: within the margin of h_l + d_l that
+/// a factor 2 leaves.
+inline constexpr double kUnbufferReach = 2.0;
+
+/// What a buffered retraction did (retract_buffered).
+template <int D>
+struct RetractResultIn {
+  std::size_t merged = 0;          // shadows that took their daughters' place back (2^D active particles into one)
+  std::size_t kept_as_buffers = 0; // of those, the ones whose daughters stayed as its buffer daughters (finer fluid near)
+  std::size_t unbuffered = 0;      // particles whose buffer daughters left: no active finer fluid within reach
+  std::size_t kept_off_walls = 0;  // families that may merge, left alone: their centre too close to a wall
+  std::size_t kept_by_criterion = 0;  // ... the merged particle would be split again at once
+  std::size_t kept_dispersed = 0;  // ... a member outside the merged particle's square
+  std::size_t kept_mixed = 0;      // ... an active particle of the family's level, not merging, within kIntermixReach
+  double d_kinetic = 0.0;          // kinetic energy after - before (<= 0), the merges'
+  Angular<D> d_angular = zero_angular<D>();
+};
+
+/// Coarsening with buffered levels, on the store between steps (after the pass's splits):
+///   - a shadow of level l whose 2^D daughters are all active and may merge (may[i] != 0) takes their place back: it
+///     becomes active with their merged state (merged_state: mass and momentum kept, the family's motion about its
+///     centre of mass reported as removed), unless merge_verdict keeps the family apart or an active particle of level
+///     l + 1 outside the merging families lies within kIntermixReach d_l + horizon (|v_merged| + the fastest such
+///     particle's speed) of the merged place (prepare_buffered_marks would split it again at once, or at the next
+///     check, `horizon` seconds on, if they keep their speeds). Where active fluid of level l + 1 stays within h_l + d_l of it, it becomes a host
+///     and its daughters its buffer daughters, where they stand; otherwise they leave;
+///   - then, finest level first, a particle of level l whose daughters are all buffer particles without daughters of
+///     their own, with no active particle of level l + 1 within kUnbufferReach (h_l + d_l), loses them (a host
+///     becomes active).
+/// `time` is written as a merged particle's level_time. Deterministic: no outcome depends on the store's order, and
+/// the sums run in sibling order.
+template <int D>
+RetractResultIn<D> retract_buffered(ParticleStore<D>& store, const std::vector<std::uint8_t>& may,
+                                    const Geometry<D>& geometry, double time, double horizon,
+                                    const std::function<bool(const Vec<D>&, const Vec<D>&)>& would_split, int max_level);
 
 }  // namespace sph::refine

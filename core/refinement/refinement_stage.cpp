@@ -1,5 +1,6 @@
 #include "core/refinement/refinement_stage.hpp"
 
+#include <algorithm>
 #include <limits>
 
 #include "core/refinement/buffer.hpp"
@@ -65,16 +66,17 @@ bool RefinementStageIn<D>::after_step(SimulationT<D>& sim) {
   ParticleStore<D>& store = sim.store();
   std::vector<std::uint8_t> marks(store.size(), 0);
   criterion_->mark(store, marks);
-  if (settings_.coarsening) {
-    // A particle a merge made at the last check is not split at this one (no family flips from one check to
-    // the next: the merge test looked one check ahead, but an impact can still change course within it).
-    for (std::size_t i = 0; i < store.size(); ++i) {
-      if (store.origin[i] == Origin::fresh_merge) {
-        marks[i] = 0;
-        store.origin[i] = Origin::merge;
-      }
-    }
-  }
+  // No family flips between split and merge from one check to the next (Origin): a particle a merge made at the last
+  // check is not split at this one (the merge test looked one check ahead, but an impact can still change course
+  // within it), and a family a split made (or made active) at the last check does not merge at this one (a split by
+  // the criterion is kept apart from a merge by the thresholds' gap, but buffered levels also split where the levels
+  // mix, whatever the speed).
+  for (std::size_t i = 0; i < store.size(); ++i)
+    if (store.origin[i] == Origin::fresh_merge) marks[i] = 0;
+  std::vector<ParticleId> split_last;  // ids, sorted: fresh_split until the end of this pass
+  for (std::size_t i = 0; i < store.size(); ++i)
+    if (store.origin[i] == Origin::fresh_split) split_last.push_back(store.id[i]);
+  std::sort(split_last.begin(), split_last.end());
   PassRecordIn<D> rec;
   rec.step = sim.step_count();
   rec.time = sim.time();
@@ -83,6 +85,8 @@ bool RefinementStageIn<D>::after_step(SimulationT<D>& sim) {
   bool any = false;
   const bool buffered = settings_.coupling == LevelCoupling::buffered;
   const std::size_t flips = buffered ? prepare_buffered_marks(store, marks, settings_.max_level) : 0;
+  for (std::size_t i = 0; i < store.size(); ++i)
+    if (store.origin[i] == Origin::fresh_merge) store.origin[i] = Origin::merge;
   for (std::size_t i = 0; i < store.size(); ++i) {
     if (!(marks[i] && store.kind[i] == Kind::fluid && store.level[i] < settings_.max_level)) continue;
     if (has_room_for_daughters<D>(store.id[i])) {
@@ -107,18 +111,31 @@ bool RefinementStageIn<D>::after_step(SimulationT<D>& sim) {
     criterion_->mark_mergeable(store, horizon, may);
     const double held_since = sim.time() - settings_.coarsening->hold_time;
     for (std::size_t i = 0; i < store.size(); ++i) {
-      if (may[i] && store.level_time[i] > held_since) may[i] = 0;
+      if (may[i] && (store.level_time[i] > held_since || store.origin[i] == Origin::fresh_split)) may[i] = 0;
     }
-    const MergeResultIn<D> m = merge_pass<D>(
-        sim, may, [&](const Vec<D>& x, const Vec<D>& v) { return criterion_->would_split(x, v); }, &merged_across_,
-        settings_.coarsening->groups);
-    rec.merged = m.merged;
-    rec.merge_d_kinetic = m.d_kinetic;
-    rec.merge_d_angular = m.d_angular;
+    const auto would_split = [&](const Vec<D>& x, const Vec<D>& v) { return criterion_->would_split(x, v); };
+    if (buffered) {  // one process (the scene refuses buffered levels across ranks)
+      const RetractResultIn<D> m = retract_buffered<D>(store, may, sim.settings().geometry, sim.time(), horizon, would_split,
+                                                       settings_.max_level);
+      rec.merged = m.merged;
+      rec.unbuffered = m.unbuffered;
+      rec.merge_d_kinetic = m.d_kinetic;
+      rec.merge_d_angular = m.d_angular;
+    } else {
+      const MergeResultIn<D> m = merge_pass<D>(sim, may, would_split, &merged_across_, settings_.coarsening->groups);
+      rec.merged = m.merged;
+      rec.merge_d_kinetic = m.d_kinetic;
+      rec.merge_d_angular = m.d_angular;
+    }
+  }
+  if (!split_last.empty()) {
+    for (std::size_t i = 0; i < store.size(); ++i)
+      if (store.origin[i] == Origin::fresh_split && std::binary_search(split_last.begin(), split_last.end(), store.id[i]))
+        store.origin[i] = Origin::split;
   }
   total_refused_ += rec.refused;
   // Only a split or a merge changes the particles (and asks for a refresh); a pass that refused splits is logged.
-  const bool changed = rec.refined > 0 || rec.merged > 0 || flips > 0;
+  const bool changed = rec.refined > 0 || rec.merged > 0 || rec.unbuffered > 0 || flips > 0;
   if (!changed && rec.refused == 0) return false;
   total_ += rec.refined;
   total_merged_ += rec.merged;

@@ -24,6 +24,7 @@ struct PassRecordIn {
   std::size_t refined = 0;
   std::size_t shifted = 0;
   std::size_t merged = 0;     // families merged (2^D into one)
+  std::size_t unbuffered = 0; // buffered levels: particles whose buffer daughters left (retract_buffered)
   std::size_t refused = 0;    // marked, but left whole: a daughter's id would not fit (family.hpp's generations)
   double merge_d_kinetic = 0.0;  // kinetic energy the merges removed (J/m in 2D, J in 3D; <= 0)
   Angular<D> merge_d_angular = zero_angular<D>();  // change of angular momentum by the merges (2D: L_z)

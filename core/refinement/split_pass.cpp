@@ -99,7 +99,7 @@ SplitResult split_marked(ParticleStore<D>& store, const std::vector<std::uint8_t
       s.level[k] = level;
       s.id[k] = daughter_id<D>(parent, static_cast<unsigned>(a));
       s.level_time[k] = time;
-      s.origin[k] = Origin::split;
+      s.origin[k] = Origin::fresh_split;
       // The parent's limits are not the daughters': until their first evaluation their bin is their level's
       // (Integrator::bin_for), as for a merged particle.
       s.stiffness[k] = 1.0;

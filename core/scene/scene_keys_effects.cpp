@@ -160,9 +160,9 @@ const S<Refinement>& refinement_section() {
               .means("families merge back where the flow no longer needs them"));
     d.add(value<Refinement>("coupling", member(&Refinement::coupling))
               .only_for({"zone", "velocity"})
-              .note("`buffered`: 2D, one process, no coarsening or static refinement, every fluid "
-                    "region at one level; fine fluid that leaves the zone stays fine, and coarse fluid it mixes with is "
-                    "refined; in a violent flow the energy can grow between passes, and a run whose fine fluid meets "
+              .note("`buffered`: 2D, one process, no static refinement, coarsening by families only, every "
+                    "fluid region at one level; fine fluid that leaves the zone stays fine until coarsening merges it "
+                    "back, and coarse fluid it mixes with is refined; in a violent flow the energy can grow between passes, and a run whose fine fluid meets "
                     "an impact can stop (docs/METHOD.md, \"Buffered levels\")")
               .means("how levels interact: every pair (`mixed`, the paper's), or each level with its own, its lattice "
                      "completed by passive particles fitted to the other levels (`buffered`, docs/METHOD.md)"));

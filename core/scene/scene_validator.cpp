@@ -195,8 +195,11 @@ void validate_scene(const Scene& s) {
     const std::string p = "effects.refinement";
     if (r.criterion == Criterion::zone) valid_rect(r.zone, p + ".zone");
     if (r.coupling == LevelCoupling::buffered) {
-      // What buffered levels do not handle yet (docs/METHOD.md, "Buffered levels"): a family is never taken back.
-      if (r.coarsening) fail(p + ".coupling", "\"buffered\" does not coarsen yet; remove effects.refinement.coarsening or use \"mixed\"");
+      // A shadow takes its family's place back (retract_buffered): the families of one parent only.
+      if (r.coarsening && r.coarsening->groups != refine::MergeGroups::family) {
+        fail(p + ".coarsening.groups", "\"buffered\" merges a shadow's own daughters back into it: use \"family\" (or "
+                                       "coupling \"mixed\")");
+      }
       if (dimension(s) == 3) {
         fail(p + ".coupling", "\"buffered\" is 2D only so far: the 3D still tank with a buffered zone is not yet still "
                               "(docs/METHOD.md, \"Buffered levels\"); use \"mixed\"");
