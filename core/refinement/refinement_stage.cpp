@@ -118,12 +118,14 @@ bool RefinementStageIn<D>::after_step(SimulationT<D>& sim) {
       const RetractResultIn<D> m = retract_buffered<D>(store, may, sim.settings().geometry, sim.time(), horizon, would_split,
                                                        settings_.max_level);
       rec.merged = m.merged;
+      rec.declined = {m.kept_off_walls, m.kept_by_criterion, m.kept_dispersed, m.kept_mixed};
       rec.unbuffered = m.unbuffered;
       rec.merge_d_kinetic = m.d_kinetic;
       rec.merge_d_angular = m.d_angular;
     } else {
       const MergeResultIn<D> m = merge_pass<D>(sim, may, would_split, &merged_across_, settings_.coarsening->groups);
       rec.merged = m.merged;
+      rec.declined = {m.kept_off_walls, m.kept_by_criterion, m.kept_dispersed, 0};
       rec.merge_d_kinetic = m.d_kinetic;
       rec.merge_d_angular = m.d_angular;
     }
@@ -134,6 +136,7 @@ bool RefinementStageIn<D>::after_step(SimulationT<D>& sim) {
         store.origin[i] = Origin::split;
   }
   total_refused_ += rec.refused;
+  total_declined_ += rec.declined;
   // Only a split or a merge changes the particles (and asks for a refresh); a pass that refused splits is logged.
   const bool changed = rec.refined > 0 || rec.merged > 0 || rec.unbuffered > 0 || flips > 0;
   if (!changed && rec.refused == 0) return false;

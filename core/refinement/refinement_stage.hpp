@@ -16,6 +16,23 @@
 
 namespace sph::refine {
 
+/// Families whose members all passed the merge test (and the hold) but were left split, by reason: the merged place
+/// too near a wall, the merged particle would be split again, a member outside the merged particle's square
+/// (dispersed), or (buffered levels) finer active fluid within the intermix reach. A family counts once per check.
+struct MergesDeclined {
+  std::size_t walls = 0;
+  std::size_t criterion = 0;
+  std::size_t dispersed = 0;
+  std::size_t mixed = 0;
+  MergesDeclined& operator+=(const MergesDeclined& o) {
+    walls += o.walls;
+    criterion += o.criterion;
+    dispersed += o.dispersed;
+    mixed += o.mixed;
+    return *this;
+  }
+};
+
 /// One line of the refinement log: what a pass did.
 template <int D>
 struct PassRecordIn {
@@ -26,6 +43,7 @@ struct PassRecordIn {
   std::size_t merged = 0;     // families merged (2^D into one)
   std::size_t unbuffered = 0; // buffered levels: particles whose buffer daughters left (retract_buffered)
   std::size_t refused = 0;    // marked, but left whole: a daughter's id would not fit (family.hpp's generations)
+  MergesDeclined declined;    // families whose members all passed the merge test, left split, by reason
   double merge_d_kinetic = 0.0;  // kinetic energy the merges removed (J/m in 2D, J in 3D; <= 0)
   Angular<D> merge_d_angular = zero_angular<D>();  // change of angular momentum by the merges (2D: L_z)
   std::vector<std::size_t> per_level;  // fluid particles per level after the pass
@@ -46,6 +64,8 @@ class RefinementStageIn final : public StageT<D> {
   /// Particles marked for a split and left whole because a daughter's id would not fit (kMaxGenerationsIn<D>: in
   /// cell groups a merged particle keeps a member's generation, so split-merge cycles can use them up).
   std::size_t total_refused() const { return total_refused_; }
+  /// Over the run: the families that could have merged and were left split, by reason (MergesDeclined).
+  const MergesDeclined& total_declined() const { return total_declined_; }
   /// Of those, the families merged on this rank with members lent by others (runs across ranks).
   std::size_t merged_across_ranks() const { return merged_across_; }
 
@@ -57,6 +77,7 @@ class RefinementStageIn final : public StageT<D> {
   std::size_t total_merged_ = 0;
   std::size_t merged_across_ = 0;
   std::size_t total_refused_ = 0;
+  MergesDeclined total_declined_;
 };
 
 using RefinementStage = RefinementStageIn<2>;

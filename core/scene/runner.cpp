@@ -359,13 +359,18 @@ void RunnerT<D>::write_summary(const Summary& r, const FailureReport* failure) {
   const double peak_rss = comm.max(static_cast<double>(usage.ru_maxrss) * 1024.0);
   // Dynamic refinement in this invocation: particles split, families merged, (across ranks) the families
   // merged with members lent by another rank, and the splits refused for want of room in a daughter's id.
+  // And the families that could have merged but were left split, by reason (refine::MergesDeclined).
   std::optional<std::array<std::uint64_t, 4>> passes;
+  std::array<std::uint64_t, 4> declined{};
   for (const auto& stage : sim_.stages()) {
     if (const auto* rs = dynamic_cast<const refine::RefinementStageIn<D>*>(stage.get())) {
       passes = std::array<std::uint64_t, 4>{comm.sum(std::uint64_t{rs->total_refined()}),
                                             comm.sum(std::uint64_t{rs->total_merged()}),
                                             comm.sum(std::uint64_t{rs->merged_across_ranks()}),
                                             comm.sum(std::uint64_t{rs->total_refused()})};
+      const refine::MergesDeclined& d = rs->total_declined();
+      declined = {comm.sum(std::uint64_t{d.walls}), comm.sum(std::uint64_t{d.criterion}),
+                  comm.sum(std::uint64_t{d.dispersed}), comm.sum(std::uint64_t{d.mixed})};
     }
   }
   if (passes && (*passes)[3] > 0 && comm.root()) {
@@ -424,7 +429,9 @@ void RunnerT<D>::write_summary(const Summary& r, const FailureReport* failure) {
   }
   if (passes) {
     j["refinement"] = {{"split", (*passes)[0]}, {"merged_families", (*passes)[1]},
-                       {"merged_families_across_ranks", (*passes)[2]}, {"splits_refused_no_id_room", (*passes)[3]}};
+                       {"merged_families_across_ranks", (*passes)[2]}, {"splits_refused_no_id_room", (*passes)[3]},
+                       {"merges_declined", {{"walls", declined[0]}, {"criterion", declined[1]},
+                                            {"dispersed", declined[2]}, {"mixed", declined[3]}}}};
   }
   j["removed_particles"] = r.final.removed;
   j["removed_mass"] = r.final.removed_mass;
