@@ -8,8 +8,11 @@ docs/METHOD.md, "Buffered flows under small changes", holds the summary table th
     /usr/bin/python3 tools/buffered_robustness.py [--app build/release/app/sphrefine] [--jobs 2]
                                                   [--couplings buffered,mixed] [--patterns aap,rsp]
 
+A coupling may carry "+coarsening" (e.g. --couplings buffered,buffered+coarsening): the zone's refinement then has
+"coarsening": {} (the defaults: fluid that has left the zone merges back after the hold).
 Each run: cases/dam_break_aap.json, one thread, a zone criterion with one level. Prints one markdown row per
-coupling, zone, pattern and perturbation, then one row per zone and pattern with the couplings side by side.
+coupling, zone, pattern and perturbation, then one row per zone and pattern with the couplings side by side. "fine
+at the end" is the active level-1 fluid in the last output row (the range over the runs that complete).
 """
 import argparse
 import csv
@@ -31,7 +34,9 @@ PERTURBATIONS = [(100, 0.2), (99, 0.2), (101, 0.2), (100, 0.19)]
 
 def run(app, coupling, zone, pattern, interval, cfl, out):
     refinement = {"criterion": "zone", "zone": {"lo": list(zone[0]), "hi": list(zone[1])}, "pattern": pattern,
-                  "check_interval": interval, "max_level": 1, "coupling": coupling}
+                  "check_interval": interval, "max_level": 1, "coupling": coupling.split("+")[0]}
+    if coupling.endswith("+coarsening"):
+        refinement["coarsening"] = {}
     cmd = [app, "run", os.path.join(ROOT, "cases", "dam_break_aap.json"), "-o", out, "--force", "-q", "--threads",
            "1", "--set", f"time.cfl={cfl}", "--set", "effects.refinement=" + json.dumps(refinement)]
     r = subprocess.run(cmd, capture_output=True, text=True)
@@ -45,15 +50,18 @@ def run(app, coupling, zone, pattern, interval, cfl, out):
     return {"status": f"stopped at {float(stop.group(1)):.2f} s" if stop else "completes",
             "rise": rise,
             "speed": max(float(row["max_speed"]) for row in rows),
-            "density": max(float(row["max_density_error"]) for row in rows)}
+            "density": max(float(row["max_density_error"]) for row in rows),
+            "fine": int(float(rows[-1].get("level_1", 0)))}
 
 
 def summary(rows):
     """(runs that complete, with the stop times; largest rise; largest speed; largest density error) of a zone's runs."""
     stops = [r["status"].replace("stopped at ", "") for r in rows if r["status"] != "completes"]
     done = f"{len(rows) - len(stops)} of {len(rows)}" + (f" (stops at {', '.join(stops)})" if stops else "")
+    fine = [r["fine"] for r in rows if r["status"] == "completes"]
     return (done, f"{max(r['rise'] for r in rows):.1e}", f"{max(r['speed'] for r in rows):.0f}",
-            f"{max(r['density'] for r in rows):.2f}")
+            f"{max(r['density'] for r in rows):.2f}",
+            (f"{min(fine)}-{max(fine)}" if min(fine) != max(fine) else str(fine[0])) if fine else "")
 
 
 def main():
@@ -67,8 +75,8 @@ def main():
         sys.exit(f"--app {args.app}: not an executable")
     couplings = args.couplings.split(",")
     for c in couplings:
-        if c not in ("buffered", "mixed"):
-            sys.exit(f"--couplings: unknown coupling {c!r} (buffered, mixed)")
+        if c.replace("+coarsening", "") not in ("buffered", "mixed"):
+            sys.exit(f"--couplings: unknown coupling {c!r} (buffered, mixed, either with +coarsening)")
     patterns = args.patterns.split(",")
     jobs = [(k, z, p, i, c) for k in couplings for z in ZONES for p in patterns for i, c in PERTURBATIONS]
     with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(args.jobs) as pool:
@@ -76,16 +84,16 @@ def main():
                                 enumerate(jobs)))
     zone_text = lambda z: f"`[{z[0][0]},{z[1][0]}] x [{z[0][1]},{z[1][1]}]`"  # noqa: E731
     print("| coupling | zone | pattern | check interval | C | run | largest energy rise between rows / E(0) "
-          "| max speed (m/s) | max density error |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "| max speed (m/s) | max density error | fine at the end |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for (k, z, p, i, c), r in zip(jobs, results):
         print(f"| {k} | {zone_text(z)} | {p.upper()} | {i} | {c} | {r['status']} | {r['rise']:.1e} | {r['speed']:.0f} "
-              f"| {r['density']:.2f} |")
+              f"| {r['density']:.2f} | {r['fine']} |")
     print()
     head = "| zone | pattern |" + "".join(f" {k}: runs that complete | largest rise / E(0) | max speed (m/s) | max "
-                                         "density error |" for k in couplings)
+                                         "density error | fine at the end |" for k in couplings)
     print(head)
-    print("|---|---|" + "---|---|---|---|" * len(couplings))
+    print("|---|---|" + "---|---|---|---|---|" * len(couplings))
     for z in ZONES:
         for p in patterns:
             cells = []
