@@ -10,11 +10,13 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
+#include <random>
 #include <vector>
 
 #include "core/case_builder.hpp"
 #include "core/integrator.hpp"
 #include "core/refinement/buffer.hpp"
+#include "core/refinement/points.hpp"
 #include "core/refinement/refinement_stage.hpp"
 #include "core/scene/runner.hpp"
 #include "core/scene/scene_parser.hpp"
@@ -735,5 +737,34 @@ TEST_P(BufferedThreads, StillTankIsBitwiseTheSameAtOneAndTwoThreads) {
 
 INSTANTIATE_TEST_SUITE_P(Stepping, BufferedThreads, ::testing::Values(TimeStepping::global, TimeStepping::per_level),
                          [](const auto& p) { return std::string(p.param == TimeStepping::global ? "global" : "per_level"); });
+
+// The grid query of the buffered levels' passes (refine::detail::Points::near) against a loop over every point:
+// random points in a 10 m square, queried at random places with reaches up to the cells' edge. Both sides compare
+// the same squared distances with the same reach, so they agree exactly.
+TEST(BufferedPoints, NearAgreesWithABruteForceLoop) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> place(0.0, 10.0), unit(0.0, 1.0);
+  std::vector<Vec<2>> x;
+  refine::detail::Points<2> points;
+  for (int k = 0; k < 400; ++k) {
+    x.emplace_back(place(rng), place(rng));
+    points.add(x.back());
+  }
+  const double edge = 0.5;
+  points.sort(edge);
+  int hits = 0;
+  for (int q = 0; q < 2000; ++q) {
+    const Vec<2> p(place(rng), place(rng));
+    const double reach = edge * unit(rng);
+    bool near = false;
+    for (const Vec<2>& xj : x) near = near || (xj - p).squaredNorm() < reach * reach;
+    EXPECT_EQ(points.near(p, reach), near) << q;
+    hits += near;
+  }
+  // Both answers occur often (4 points per m^2, reaches of 0-0.5 m: about one point in reach on average), so the
+  // comparison tests something.
+  EXPECT_GT(hits, 200);
+  EXPECT_LT(hits, 1800);
+}
 
 }  // namespace

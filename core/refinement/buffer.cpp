@@ -8,41 +8,9 @@
 #include <utility>
 
 #include "core/refinement/family.hpp"
+#include "core/refinement/points.hpp"
 
 namespace sph::refine {
-
-namespace {
-
-/// Points sorted into the project's cell grid (one layer, cells of edge `edge`): near(x, reach) is true when a point
-/// lies within reach <= edge of x.
-template <int D>
-class Points {
- public:
-  void add(const Vec<D>& x) { x_.push_back(x); }
-  bool empty() const { return x_.empty(); }
-  void sort(double edge) {
-    if (x_.empty()) return;
-    // A query around p with "smoothing length" h reaches h + max_h: max_h = edge / 2, and near() asks h = reach - max_h.
-    grid_.build(x_.data(), x_.size(), edge, 0.5 * edge);
-    half_edge_ = 0.5 * edge;
-  }
-  bool near(const Vec<D>& x, double reach) const {
-    if (x_.empty()) return false;
-    bool found = false;
-    const auto& order = grid_.order();
-    grid_.for_each_support_run(x, reach - half_edge_, [&](std::uint32_t b, std::uint32_t e) {
-      for (std::uint32_t k = b; k < e && !found; ++k) found = (x_[order[k]] - x).squaredNorm() < reach * reach;
-    });
-    return found;
-  }
-
- private:
-  std::vector<Vec<D>> x_;
-  CellGrid<D> grid_;
-  double half_edge_ = 0.0;
-};
-
-}  // namespace
 
 template <int D>
 void tie_buffers(ParticleStore<D>& store) {
@@ -82,7 +50,7 @@ std::size_t prepare_buffered_marks(ParticleStore<D>& store, std::vector<std::uin
   std::vector<std::uint8_t> mixed(n, 0);
   for (int l = 0; l < max_level; ++l) {
     double reach = 0.0;
-    Points<D> finer;
+    detail::Points<D> finer;
     for (std::size_t i = 0; i < n; ++i) {
       if (!fluid(i)) continue;
       if (store.level[i] == l) reach = std::max(reach, kIntermixReach * store.d[i]);
@@ -128,7 +96,7 @@ std::size_t prepare_buffered_marks(ParticleStore<D>& store, std::vector<std::uin
       if (fluid(i) && store.level[i] == l) reach = std::max(reach, (1.0 + half_diagonal) * store.d[i] + store.h[i]);
     }
     if (!(reach > 0.0)) continue;
-    Points<D> active, marked;
+    detail::Points<D> active, marked;
     for (std::size_t i = 0; i < n; ++i) {
       if (!fluid(i)) continue;
       if (store.level[i] == l + 1 && !is_passive(store.role[i])) active.add(store.x[i]);
@@ -230,9 +198,10 @@ RetractResultIn<D> retract_buffered(ParticleStore<D>& store, const std::vector<s
   });
   // Not where the finer level stays mixed in, now or by the next check: an active particle of level l + 1 that does
   // not merge within kIntermixReach d_l of the merged place would have it split again at the next check
-  // (prepare_buffered_marks), and so would one that comes that near before it, at the speeds they have now: the
-  // reach grows by horizon (|v_merged| + the fastest such particle's speed). Those that merge are left out, to a fixed
-  // point (a family kept back keeps its members in).
+  // (prepare_buffered_marks), and so would one that could come that near before it: the reach grows by horizon
+  // (|v_merged| + the fastest such particle's speed). (Each particle's own speed instead let a merged particle be split
+  // at the next check in CoarseningFlips/buffered: speeds change within a check.) Those that merge are left out, to a
+  // fixed point (a family kept back keeps its members in).
   std::vector<std::uint8_t> merging(n, 0);
   for (bool again = true; again;) {
     again = false;
@@ -241,7 +210,7 @@ RetractResultIn<D> retract_buffered(ParticleStore<D>& store, const std::vector<s
       if (f.verdict == 0)
         for (const std::uint32_t a : f.members) merging[a] = 1;
     for (int l = 0; l < max_level; ++l) {
-      Points<D> finer;
+      detail::Points<D> finer;
       double fastest = 0.0;
       for (std::size_t i = 0; i < n; ++i) {
         if (!(active(i) && store.level[i] == l + 1 && !merging[i])) continue;
@@ -283,7 +252,7 @@ RetractResultIn<D> retract_buffered(ParticleStore<D>& store, const std::vector<s
   // plain active.
   std::vector<std::uint8_t> keep_band(fam.size(), 0);
   for (int l = 0; l < max_level; ++l) {
-    Points<D> staying;
+    detail::Points<D> staying;
     double reach = 0.0;
     for (const Family& f : fam)
       if (f.verdict == 0 && store.level[f.shadow] == l) reach = std::max(reach, store.h[f.shadow] + store.d[f.shadow]);
@@ -329,7 +298,7 @@ RetractResultIn<D> retract_buffered(ParticleStore<D>& store, const std::vector<s
     for (std::size_t i = 0; i < n; ++i)
       if (fluid(i) && store.level[i] == l) reach = std::max(reach, kUnbufferReach * (store.h[i] + store.d[i]));
     if (!(reach > 0.0)) continue;
-    Points<D> finer;
+    detail::Points<D> finer;
     for (std::size_t i = 0; i < n; ++i)
       if (active(i) && store.level[i] == l + 1) finer.add(store.x[i]);
     finer.sort(reach);
