@@ -272,13 +272,7 @@ RetractResultIn<D> retract_buffered(ParticleStore<D>& store, const std::vector<s
     const Family& f = fam[r];
     if (f.verdict != 0) continue;
     const std::size_t k = f.shadow;
-    s.x[k] = f.state.x;
-    s.v[k] = f.state.v;
-    s.vh[k] = f.state.vh;
-    s.m[k] = f.state.m;
-    s.rho[k] = f.state.rho;
-    s.rhoh[k] = f.state.rhoh;
-    start_merged(s, k, time);
+    start_merged(s, k, f.state, time);
     s.role[k] = keep_band[r] ? Role::host : Role::active;
     result.kept_as_buffers += keep_band[r];
     for (const std::uint32_t a : f.members) {

@@ -120,17 +120,11 @@ MergeResultIn<D> merge_families(ParticleStore<D>& store, const std::vector<std::
         if (generation(id) < generation(merged_id) || (generation(id) == generation(merged_id) && id < merged_id)) merged_id = id;
       }
     }
-    s.x[k] = f.state.x;
-    s.v[k] = f.state.v;
-    s.vh[k] = f.state.vh;
-    s.m[k] = f.state.m;
-    s.rho[k] = f.state.rho;
-    s.rhoh[k] = f.state.rhoh;
+    start_merged(s, k, f.state, time);
     s.h[k] = 2.0 * s.h[f.members[0]];  // powers of two: the parent's h and d exactly
     s.d[k] = 2.0 * s.d[f.members[0]];
     s.level[k] = s.level[f.members[0]] - 1;
     s.id[k] = merged_id;
-    start_merged(s, k, time);
   });
   // Ghosts go too, as in the split pass: the solver rebuilds them for the new set.
   store.compact([&](std::size_t i) { return drop[i] == 0 && store.kind[i] != Kind::ghost; });

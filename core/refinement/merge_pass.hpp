@@ -35,26 +35,6 @@ bool clear_of_walls(const Vec<D>& x, const Geometry<D>& geometry, const std::vec
   return true;
 }
 
-/// A particle a merge has just made (merge_families, and retract_buffered in core/refinement/buffer.hpp): born at
-/// `time`, marked fresh (not split at the next check), with no rates, step history or limits of its own until the
-/// evaluation after the pass; its bin is its level's (Integrator::bin_for).
-template <int D>
-void start_merged(ParticleView<D> s, std::size_t k, double time) {
-  s.level_time[k] = time;
-  s.origin[k] = Origin::fresh_merge;
-  s.tie[k].setZero();  // it took no place beside a parent (and a member's would depend on which one holds it)
-  s.a[k].setZero();  // the rates are re-evaluated after the pass
-  s.drho[k] = 0.0;
-  s.full_a[k].setZero();
-  s.full_drho[k] = 0.0;
-  s.kick[k].setZero();
-  s.kick_rho[k] = 0.0;
-  s.jerk[k].setZero();  // no history of its own: its first step predicts from its first rates alone
-  s.density_jerk[k] = 0.0;
-  s.stiffness[k] = 1.0;
-  s.dt_limit[k] = 0.0;
-}
-
 /// What 2^D particles become when they merge: mass M = sum m_a; position and velocity (and the half-step velocity)
 /// the mass-weighted means; density M / sum (m_a / rho_a) (and the same of rhoh). Summed in the members' order.
 template <int D>
@@ -92,6 +72,33 @@ MergedStateIn<D> merged_state(const ParticleStore<D>& store, const Members& memb
   f.d_kinetic = 0.5 * f.m * f.v.squaredNorm() - ke;
   f.d_angular = f.m * cross<D>(f.x, f.v) - lz;
   return f;
+}
+
+/// Store slot k becomes the particle a merge has just made (merge_families, and retract_buffered in
+/// core/refinement/buffer.hpp): the merged state, born at `time`, marked fresh (not split at the next check), with no
+/// rates, step history or limits of its own until the evaluation after the pass; its bin is its level's
+/// (Integrator::bin_for). Its level, h, d, id and role are the caller's.
+template <int D>
+void start_merged(ParticleView<D> s, std::size_t k, const MergedStateIn<D>& state, double time) {
+  s.x[k] = state.x;
+  s.v[k] = state.v;
+  s.vh[k] = state.vh;
+  s.m[k] = state.m;
+  s.rho[k] = state.rho;
+  s.rhoh[k] = state.rhoh;
+  s.level_time[k] = time;
+  s.origin[k] = Origin::fresh_merge;
+  s.tie[k].setZero();  // it took no place beside a parent (and a member's would depend on which one holds it)
+  s.a[k].setZero();  // the rates are re-evaluated after the pass
+  s.drho[k] = 0.0;
+  s.full_a[k].setZero();
+  s.full_drho[k] = 0.0;
+  s.kick[k].setZero();
+  s.kick_rho[k] = 0.0;
+  s.jerk[k].setZero();  // no history of its own: its first step predicts from its first rates alone
+  s.density_jerk[k] = 0.0;
+  s.stiffness[k] = 1.0;
+  s.dt_limit[k] = 0.0;
 }
 
 /// Why a group that may merge stays apart: 0 it merges, 1 its centre is off the fluid domain or too close to a wall,
