@@ -3,6 +3,7 @@
 // checkpoint (in a copy of the folder taken after the checkpoint, as if killed then) ends bitwise identical
 // to the uninterrupted run, with the same time series and XDMF.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <omp.h>
 
 #include <unistd.h>
@@ -13,6 +14,7 @@
 
 #include "core/io/atomic_file.hpp"
 #include "core/io/hdf5_frames.hpp"
+#include "core/refinement/refinement_stage.hpp"
 #include "core/scene/runner.hpp"
 #include "core/scene/scene_parser.hpp"
 #include "tests/support/test_scale.hpp"
@@ -187,6 +189,34 @@ TEST(Runner, ResumedRunWithCoarseningIsBitwiseIdenticalToTheUninterruptedOne) {
       merged += st.origin[i] == Origin::merge || st.origin[i] == Origin::fresh_merge;
     EXPECT_GT(merged, 0u) << "no family merged: the test would not see the merge's state";
   });
+}
+
+// run.json's refinement section is the stage's own count of this invocation: the particles split, the families
+// merged, and the families that passed the merge test and the hold but were left split, by reason (the run above,
+// uninterrupted).
+TEST(Runner, RunJsonCountsTheMergesAndTheFamiliesLeftSplit) {
+  scene::Scene s = tiny_zone_scene(Vec<2>(0.7, 0.0), Vec<2>(1.0, 0.4), 1);
+  s.effects.refinement->coarsening = scene::Coarsening{};
+  s.effects.refinement->coarsening->hold_time = 0.005;
+  s.time.end = 0.15;
+  TempFolder tmp;
+  const fs::path out = tmp.path() / "out";
+  scene::Runner runner(s, scene::RunOptions{out, std::nullopt, 0.05});
+  runner.run();
+  const refine::RefinementStage* stage = nullptr;
+  for (const auto& st : runner.simulation().stages())
+    if (const auto* rs = dynamic_cast<const refine::RefinementStage*>(st.get())) stage = rs;
+  ASSERT_NE(stage, nullptr);
+  ASSERT_GT(stage->total_merged(), 0u) << "no family merged: the count would not be seen";
+  const auto j = nlohmann::json::parse(io::read_file(io::RunFiles{out}.summary())).at("refinement");
+  EXPECT_EQ(j.at("split").get<std::size_t>(), stage->total_refined());
+  EXPECT_EQ(j.at("merged_families").get<std::size_t>(), stage->total_merged());
+  const auto& declined = j.at("merges_declined");
+  EXPECT_EQ(declined.at("walls").get<std::size_t>(), stage->total_declined().walls);
+  EXPECT_EQ(declined.at("criterion").get<std::size_t>(), stage->total_declined().criterion);
+  EXPECT_EQ(declined.at("dispersed").get<std::size_t>(), stage->total_declined().dispersed);
+  EXPECT_EQ(declined.at("mixed").get<std::size_t>(), stage->total_declined().mixed);
+  EXPECT_EQ(stage->total_declined().mixed, 0u) << "mixed coupling has no intermix rule";
 }
 
 // The same with per-level time steps (time.stepping = "per_level") and two levels of refinement in a zone: a
