@@ -215,8 +215,8 @@ TEST(Runner, RunJsonCountsTheMergesAndTheFamiliesLeftSplit) {
   EXPECT_EQ(declined.at("walls").get<std::size_t>(), stage->total_declined().walls);
   EXPECT_EQ(declined.at("criterion").get<std::size_t>(), stage->total_declined().criterion);
   EXPECT_EQ(declined.at("dispersed").get<std::size_t>(), stage->total_declined().dispersed);
-  EXPECT_EQ(declined.at("mixed").get<std::size_t>(), stage->total_declined().mixed);
-  EXPECT_EQ(stage->total_declined().mixed, 0u) << "mixed coupling has no intermix rule";
+  EXPECT_EQ(declined.at("intermixed").get<std::size_t>(), stage->total_declined().intermixed);
+  EXPECT_EQ(stage->total_declined().intermixed, 0u) << "mixed coupling has no intermix rule";
 }
 
 // The same with per-level time steps (time.stepping = "per_level") and two levels of refinement in a zone: a

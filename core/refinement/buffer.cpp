@@ -245,7 +245,7 @@ RetractResultIn<D> retract_buffered(ParticleStore<D>& store, const std::vector<s
       case 1: ++result.kept_off_walls; break;
       case 2: ++result.kept_by_criterion; break;
       case 3: ++result.kept_dispersed; break;
-      default: ++result.kept_mixed; break;
+      default: ++result.kept_intermixed; break;
     }
   }
   // The merged shadows: a host where active fluid of level l + 1 that stays is within its daughters' support, else

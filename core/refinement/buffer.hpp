@@ -174,7 +174,7 @@ struct RetractResultIn {
   std::size_t kept_off_walls = 0;  // families that may merge, left alone: their centre too close to a wall
   std::size_t kept_by_criterion = 0;  // ... the merged particle would be split again at once
   std::size_t kept_dispersed = 0;  // ... a member outside the merged particle's square
-  std::size_t kept_mixed = 0;      // ... an active particle of the family's level, not merging, within kIntermixReach
+  std::size_t kept_intermixed = 0; // ... an active particle of level l + 1 that stays, within the intermix reach
   double d_kinetic = 0.0;          // kinetic energy after - before (<= 0), the merges'
   Angular<D> d_angular = zero_angular<D>();
 };

@@ -118,7 +118,7 @@ bool RefinementStageIn<D>::after_step(SimulationT<D>& sim) {
       const RetractResultIn<D> m = retract_buffered<D>(store, may, sim.settings().geometry, sim.time(), horizon, would_split,
                                                        settings_.max_level);
       rec.merged = m.merged;
-      rec.declined = {m.kept_off_walls, m.kept_by_criterion, m.kept_dispersed, m.kept_mixed};
+      rec.declined = {m.kept_off_walls, m.kept_by_criterion, m.kept_dispersed, m.kept_intermixed};
       rec.unbuffered = m.unbuffered;
       rec.merge_d_kinetic = m.d_kinetic;
       rec.merge_d_angular = m.d_angular;

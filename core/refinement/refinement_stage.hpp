@@ -18,17 +18,17 @@ namespace sph::refine {
 
 /// Families whose members all passed the merge test (and the hold) but were left split, by reason: the merged place
 /// too near a wall, the merged particle would be split again, a member outside the merged particle's square
-/// (dispersed), or (buffered levels) finer active fluid within the intermix reach. A family counts once per check.
+/// (dispersed), or (buffered levels) finer active fluid within the intermix reach (intermixed). A family counts once per check.
 struct MergesDeclined {
   std::size_t walls = 0;
   std::size_t criterion = 0;
   std::size_t dispersed = 0;
-  std::size_t mixed = 0;
+  std::size_t intermixed = 0;
   MergesDeclined& operator+=(const MergesDeclined& o) {
     walls += o.walls;
     criterion += o.criterion;
     dispersed += o.dispersed;
-    mixed += o.mixed;
+    intermixed += o.intermixed;
     return *this;
   }
 };

@@ -370,7 +370,7 @@ void RunnerT<D>::write_summary(const Summary& r, const FailureReport* failure) {
                                             comm.sum(std::uint64_t{rs->total_refused()})};
       const refine::MergesDeclined& d = rs->total_declined();
       declined = {comm.sum(std::uint64_t{d.walls}), comm.sum(std::uint64_t{d.criterion}),
-                  comm.sum(std::uint64_t{d.dispersed}), comm.sum(std::uint64_t{d.mixed})};
+                  comm.sum(std::uint64_t{d.dispersed}), comm.sum(std::uint64_t{d.intermixed})};
     }
   }
   if (passes && (*passes)[3] > 0 && comm.root()) {
@@ -431,7 +431,7 @@ void RunnerT<D>::write_summary(const Summary& r, const FailureReport* failure) {
     j["refinement"] = {{"split", (*passes)[0]}, {"merged_families", (*passes)[1]},
                        {"merged_families_across_ranks", (*passes)[2]}, {"splits_refused_no_id_room", (*passes)[3]},
                        {"merges_declined", {{"walls", declined[0]}, {"criterion", declined[1]},
-                                            {"dispersed", declined[2]}, {"mixed", declined[3]}}}};
+                                            {"dispersed", declined[2]}, {"intermixed", declined[3]}}}};
   }
   j["removed_particles"] = r.final.removed;
   j["removed_mass"] = r.final.removed_mass;

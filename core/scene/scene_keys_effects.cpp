@@ -162,8 +162,8 @@ const S<Refinement>& refinement_section() {
               .only_for({"zone", "velocity"})
               .note("`buffered`: 2D, one process, no static refinement, coarsening by families only, every "
                     "fluid region at one level; fine fluid that leaves the zone stays fine until coarsening merges it "
-                    "back, and coarse fluid it mixes with is refined; in a violent flow the energy can grow between passes, and a run whose fine fluid meets "
-                    "an impact can stop (docs/METHOD.md, \"Buffered levels\")")
+                    "back, and coarse fluid it mixes with is refined; in a violent flow the energy can grow between "
+                    "passes, and a run whose fine fluid meets an impact can stop (docs/METHOD.md, \"Buffered levels\")")
               .means("how levels interact: every pair (`mixed`, the paper's), or each level with its own, its lattice "
                      "completed by passive particles fitted to the other levels (`buffered`, docs/METHOD.md)"));
     d.add(value<Refinement>("daughter_density", member(&Refinement::daughter_density))
