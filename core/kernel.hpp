@@ -61,6 +61,50 @@ struct CubicSpline {
     return 0.0;
   }
 
+  /// d^2W/dr^2(r, h). Continuous (the spline is C^2): -3 + 4.5 q and 1.5 (2 - q) meet at q = 1.
+  static double second_derivative(double r, double h) {
+    const double q = r / h;
+    const double c = norm(h) / (h * h);
+    if (q < 1.0) return c * (-3.0 + 4.5 * q);
+    if (q < 2.0) return c * 1.5 * (2.0 - q);
+    return 0.0;
+  }
+
+  /// The stiffness S of the alternating-layer shear mode of the square (cubic) lattice under pressure, for h = h_over_d
+  /// d. In the mode the layers normal to the last axis (up) move along the first axis by +u and -u in turn: the wave
+  /// vector is pi / d along the last axis, so every lattice vector's phase is a multiple of pi and the mode changes no
+  /// particle's density (sum_j grad W_ij sin(k.x_ij) = 0): the speed of sound does not resist it, only the way the
+  /// pressure term depends on the particles' arrangement. The symmetric pressure term, -sum_j m (p_i / rho_i^2 +
+  /// p_j / rho_j^2) grad W_ij, linearised about the lattice at uniform p and rho (m = rho d^D), gives
+  ///   u'' = -(2 p / rho) (S / d^2) u,   S = sum over the lattice points n of spacing 1 with n_last odd of 2 d^2W/dx_0^2(n)
+  /// (W at h = h_over_d). Where S < 0 the mode grows as exp(t sqrt(-2 S p / rho) / d): under hydrostatic pressure
+  /// it grows fastest at the floor, at a rate set by the water's depth and not by c0. S < 0 in 3D for h / d in about
+  /// 1.03-1.26, 1.51-1.70 and 1.79-2.19 (the paper's 1.2 among them), in 2D in 0.95-1.20 and 1.52-2.10 (at 1.2 S is
+  /// +0.002); a refinement pass seeds the mode (docs/METHOD.md, "Three dimensions: a lattice mode").
+  static double layer_shear_stiffness(double h_over_d) {
+    const int n = static_cast<int>(std::ceil(2.0 * h_over_d));
+    const int side = 2 * n + 1;
+    int count = 1;
+    for (int k = 0; k < D; ++k) count *= side;
+    double sum = 0.0;
+    for (int c = 0; c < count; ++c) {
+      int rest = c;
+      int idx[3] = {0, 0, 0};
+      double r2 = 0.0;
+      for (int k = 0; k < D; ++k) {
+        idx[k] = rest % side - n;
+        rest /= side;
+        r2 += static_cast<double>(idx[k] * idx[k]);
+      }
+      if (idx[D - 1] % 2 == 0) continue;  // the layers that move with the particle at the origin (and itself)
+      const double r = std::sqrt(r2);
+      const double e0 = static_cast<double>(idx[0]) / r;  // the first axis' share of the unit vector
+      // d^2W/dx_0^2 = W'' e0^2 + (W' / r) (1 - e0^2)
+      sum += 2.0 * (second_derivative(r, h_over_d) * e0 * e0 + derivative(r, h_over_d) / r * (1.0 - e0 * e0));
+    }
+    return sum;
+  }
+
   /// h sum_j d^D |grad W(x_j, h)| over the points x_j != 0 of a square (cubic) lattice of spacing d, for
   /// h = h_over_d d: the kernel-gradient sum a particle on its own lattice sees, in units of 1/h (it does not
   /// depend on d). 2D at h = 1.2 d: 1.964; 3D at h = 1.2 d: 2.651.

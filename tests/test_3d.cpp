@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,82 @@ using sph::test::ThreadCount;
 using Vec3 = sph::Vec<3>;
 
 constexpr double kG = 9.81;  // the cases' gravity (m/s^2)
+
+// ---------------------------------------------------------------------------------------------------
+// A lattice mode of 3D still water (docs/METHOD.md, "Three dimensions: a lattice mode")
+
+/// The amplitude of the alternating-layer shear mode in the tank: the fluid's x-velocity projected on the seed's
+/// shape, (-1)^layer sin(2 pi x / L) (layer = the lattice row in z; the sine vanishes at the end walls).
+double layer_shear_amplitude(sph::SimulationT<3>& sim, const sph::Tank3Spec& spec, double seed = 0.0) {
+  auto& s = sim.store();
+  double vu = 0.0, uu = 0.0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] != Kind::fluid) continue;
+    const long layer = std::lround(s.x[i][2] / spec.spacing - 0.5);
+    const double u = (layer % 2 == 0 ? 1.0 : -1.0) * std::sin(2.0 * std::numbers::pi * s.x[i][0] / spec.length);
+    if (seed != 0.0) {  // the seed: the mode's velocity in every velocity the integrator holds
+      s.v[i][0] += seed * u;
+      s.vh[i][0] += seed * u;
+      s.v_open[i][0] += seed * u;
+    }
+    vu += s.v[i][0] * u;
+    uu += u * u;
+  }
+  return vu / uu;
+}
+
+// The still tank at h = 1.2 d and 1.3 d, seeded with the alternating-layer shear mode at 1 mm/s. Where the mode's
+// stiffness (CubicSpline::layer_shear_stiffness) is negative it grows at up to sqrt(-2 S g H) / d, the rate at the
+// floor's pressure rho g H (19 /s at h = 1.2 d), and at sqrt(-S g H) / d (14 /s) at mid-depth: over 0.6 s the lower
+// half alone would grow it by e^8. Within 0.6 s it must reach ten times the seed (a bound far below that growth, so that
+// the seed's share in the growing mode, which the tank's other motions take part of, does not decide it), and between
+// two samples it may not grow faster than the floor's rate. Where the stiffness is positive the mode is stable, and the
+// seed must not grow at all. (The tank without a seed stays still at both: StillTank3D.)
+TEST(LayerShearMode3D, GrowsWhereItsStiffnessIsNegativeAndNotWhereItIsPositive) {
+  ASSERT_LT(sph::CubicSpline<3>::layer_shear_stiffness(1.2), 0.0);
+  ASSERT_GT(sph::CubicSpline<3>::layer_shear_stiffness(1.3), 0.0);
+  const double seed = 1e-3;
+  const double sample = 0.05;  // s
+  for (double h : {1.2, 1.3}) {
+    SCOPED_TRACE(testing::Message() << "h = " << h << " d");
+    sph::Tank3Spec spec;
+    spec.h_factor = h;
+    if (sph::test::short_runs()) {
+      spec.length = 0.4;
+      spec.width = 0.2;
+      spec.depth = 0.3;
+      spec.reference_height = 0.15;
+    }
+    sph::SimulationT<3> sim = sph::make_still_tank(spec);
+    const double stiffness = sph::CubicSpline<3>::layer_shear_stiffness(h);
+    const double floor_rate = std::sqrt(std::max(0.0, -2.0 * stiffness * kG * spec.depth)) / spec.spacing;
+    const double a0 = layer_shear_amplitude(sim, spec, seed);
+    ASSERT_NEAR(a0, seed, 1e-12);
+    std::vector<double> amplitude{a0};
+    const double end = sph::test::short_runs() ? 0.1 : 0.6;
+    for (double t = sample; t < end + 0.5 * sample; t += sample) {
+      while (sim.time() < t * (1.0 - 1e-14)) sim.step(t - sim.time());
+      amplitude.push_back(layer_shear_amplitude(sim, spec));
+    }
+    double largest = 0.0, fastest = 0.0;
+    for (std::size_t k = 0; k < amplitude.size(); ++k) {
+      largest = std::max(largest, std::abs(amplitude[k]));
+      if (k > 0 && std::abs(amplitude[k - 1]) > seed)  // once grown past the seed, where the mode dominates
+        fastest = std::max(fastest, std::log(std::abs(amplitude[k]) / std::abs(amplitude[k - 1])) / sample);
+    }
+    std::string series;
+    for (double a : amplitude) series += " " + std::to_string(a);
+    SCOPED_TRACE("amplitude every 0.05 s:" + series);
+    RecordProperty(h < 1.25 ? "largest_over_seed_h1_2" : "largest_over_seed_h1_3", std::to_string(largest / seed));
+    if (sph::test::short_runs()) continue;  // 0.1 s: a smoke run under the sanitizer
+    if (stiffness < 0.0) {
+      EXPECT_GE(largest, 10.0 * seed);
+      EXPECT_LE(fastest, floor_rate) << "the floor's rate " << floor_rate << " /s";
+    } else {
+      EXPECT_LE(largest, seed);
+    }
+  }
+}
 
 // ---------------------------------------------------------------------------------------------------
 // The driver in 3D

@@ -133,6 +133,56 @@ TEST(Kernel, AcousticLengthIsHOnTheLatticeAndShorterWhereStiffer) {
   EXPECT_DOUBLE_EQ(t.acoustic_length(h, d, rho, 0.0), h);  // an isolated particle
 }
 
+TEST(Kernel, SecondDerivativeEqualsFiniteDifferenceOfTheDerivative) {
+  // Central differences of dW/dr with step e: their rounding, 1e-16 |dW/dr| / e, is about 1e-11 norm(h), and their
+  // truncation e^2/6 d^4W/dr^4 smaller still (the points stay off q = 1, where the third derivative jumps). The bound,
+  // 1e-7 norm(h), stands far above both and far below a wrong coefficient (of order norm(h) / h^2).
+  const double e = 1e-6;
+  for (double r : {0.1, 0.55, 0.9, 1.3, 1.9, 2.6}) {
+    const double fd = (CubicSpline<3>::derivative(r + e, 1.4) - CubicSpline<3>::derivative(r - e, 1.4)) / (2 * e);
+    EXPECT_NEAR(CubicSpline<3>::second_derivative(r, 1.4), fd, 1e-7 * CubicSpline<3>::norm(1.4)) << r;
+  }
+}
+
+/// The force along x on the particle at the origin of a lattice of spacing 1 whose layers with an odd last index are
+/// moved by -eps along x and the others (the origin's among them) by +eps: the pressure term's kernel sum
+/// sum_j grad_i W(x_i - x_j), from the gradient the pair sweep uses (gradient_factor). Its slope in eps is S.
+template <int D>
+double layer_shear_force(double h, double eps) {
+  const int n = 4;
+  double f = 0.0;
+  int idx[3] = {0, 0, 0};
+  for (int a = -n; a <= n; ++a)
+    for (int b = -n; b <= n; ++b)
+      for (int c = (D == 3 ? -n : 0); c <= (D == 3 ? n : 0); ++c) {
+        idx[0] = a;
+        idx[1] = b;
+        idx[2] = c;
+        if (a == 0 && b == 0 && c == 0) continue;
+        const bool odd = idx[D - 1] % 2 != 0;
+        double x[3] = {-static_cast<double>(a) + (odd ? 2.0 * eps : 0.0), -static_cast<double>(b), -static_cast<double>(c)};
+        double r2 = 0.0;
+        for (int k = 0; k < D; ++k) r2 += x[k] * x[k];
+        f += CubicSpline<D>::gradient_factor(std::sqrt(r2), h) * x[0];
+      }
+  return f;
+}
+
+// The fast sum (layer_shear_stiffness: the Hessian summed over the moving layers) against its brute-force twin,
+// the slope of the force the sweep's own gradient gives on the moved lattice, by central differences: error of
+// order eps^2 times the kernel's fourth derivative, about 1e-10 at eps = 1e-5 (rounding adds 1e-15 / eps), within the
+// bound 1e-8 (|S| is 0.002-0.1 here). The h avoid a lattice point at q = 2 that the displacement moves across (at
+// h = 1.5, n = (2, 2, 1) sits at r = 3): there the third derivative jumps, and the difference errs by order eps.
+TEST(Kernel, LayerShearStiffnessIsTheSlopeOfTheSweepsForceOnTheMovedLattice) {
+  const double eps = 1e-5;
+  for (double h : {1.0, 1.2, 1.3, 1.45, 1.732}) {
+    const double fd3 = (layer_shear_force<3>(h, eps) - layer_shear_force<3>(h, -eps)) / (2 * eps);
+    const double fd2 = (layer_shear_force<2>(h, eps) - layer_shear_force<2>(h, -eps)) / (2 * eps);
+    EXPECT_NEAR(CubicSpline<3>::layer_shear_stiffness(h), fd3, 1e-8) << h;
+    EXPECT_NEAR(CubicSpline<2>::layer_shear_stiffness(h), fd2, 1e-8) << h;
+  }
+}
+
 TEST(Kernel, CompactSupport) {
   for (double h : {0.3, 1.0, 2.5}) {
     EXPECT_EQ(CubicSpline<2>::value(2.0 * h, h), 0.0);
