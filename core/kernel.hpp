@@ -79,8 +79,8 @@ struct CubicSpline {
   ///   u'' = -(2 p / rho) (S / d^2) u,   S = sum over the lattice points n of spacing 1 with n_last odd of 2 d^2W/dx_0^2(n)
   /// (W at h = h_over_d). Where S < 0 the mode grows as exp(t sqrt(-2 S p / rho) / d): under hydrostatic pressure
   /// it grows fastest at the floor, at a rate set by the water's depth and not by c0. S < 0 in 3D for h / d in about
-  /// 1.03-1.26, 1.51-1.70 and 1.79-2.19 (the paper's 1.2 among them), in 2D in 0.95-1.20 and 1.52-2.10 (at 1.2 S is
-  /// +0.002); a refinement pass seeds the mode (docs/METHOD.md, "Three dimensions: a lattice mode").
+  /// 0.5-0.9, 1.03-1.26, 1.51-1.70, 1.79-2.19 and 2.52-3 (the paper's 1.2 among them), in 2D in 0.5-0.81, 0.95-1.20,
+  /// 1.52-2.10 and 2.43-3 (at 1.2 S is +0.002); a refinement pass seeds the mode (docs/METHOD.md, "Three dimensions: a lattice mode").
   static double layer_shear_stiffness(double h_over_d) {
     const int n = static_cast<int>(std::ceil(2.0 * h_over_d));
     const int side = 2 * n + 1;

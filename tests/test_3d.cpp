@@ -28,6 +28,21 @@ using Vec3 = sph::Vec<3>;
 
 constexpr double kG = 9.81;  // the cases' gravity (m/s^2)
 
+/// The 3D still tank of these tests at h = h_factor d: 1 x 0.4 m, 0.5 m deep, d = 0.05 m (1600 particles); under the
+/// sanitizer preset (SPH_TEST_SCALE=short), which looks for memory and undefined-behaviour errors, a 0.4 x 0.2 m tank
+/// 0.3 m deep (192 particles).
+sph::Tank3Spec test_tank(double h_factor) {
+  sph::Tank3Spec spec;
+  spec.h_factor = h_factor;
+  if (sph::test::short_runs()) {
+    spec.length = 0.4;
+    spec.width = 0.2;
+    spec.depth = 0.3;
+    spec.reference_height = 0.15;
+  }
+  return spec;
+}
+
 // ---------------------------------------------------------------------------------------------------
 // A lattice mode of 3D still water (docs/METHOD.md, "Three dimensions: a lattice mode")
 
@@ -65,14 +80,7 @@ TEST(LayerShearMode3D, GrowsWhereItsStiffnessIsNegativeAndNotWhereItIsPositive) 
   const double sample = 0.05;  // s
   for (double h : {1.2, 1.3}) {
     SCOPED_TRACE(testing::Message() << "h = " << h << " d");
-    sph::Tank3Spec spec;
-    spec.h_factor = h;
-    if (sph::test::short_runs()) {
-      spec.length = 0.4;
-      spec.width = 0.2;
-      spec.depth = 0.3;
-      spec.reference_height = 0.15;
-    }
+    const sph::Tank3Spec spec = test_tank(h);
     sph::SimulationT<3> sim = sph::make_still_tank(spec);
     const double stiffness = sph::CubicSpline<3>::layer_shear_stiffness(h);
     const double floor_rate = std::sqrt(std::max(0.0, -2.0 * stiffness * kG * spec.depth)) / spec.spacing;
@@ -161,18 +169,9 @@ struct TankSettings {
 class StillTank3D : public testing::TestWithParam<TankSettings> {};
 
 TEST_P(StillTank3D, StaysStillAndHydrostatic) {
-  // 1 x 0.4 m, 0.5 m deep, d = 0.05 m: 1600 particles. Under the sanitizer preset (SPH_TEST_SCALE=short), which
-  // looks for memory and undefined-behaviour errors, a 0.4 x 0.2 m tank 0.3 m deep (192 particles).
   const TankSettings& settings = GetParam();
-  sph::Tank3Spec spec;
-  spec.h_factor = settings.h_factor;
+  sph::Tank3Spec spec = test_tank(settings.h_factor);
   spec.mach_factor = settings.mach_factor;
-  if (sph::test::short_runs()) {
-    spec.length = 0.4;
-    spec.width = 0.2;
-    spec.depth = 0.3;
-    spec.reference_height = 0.15;
-  }
   sph::SimulationT<3> sim = sph::make_still_tank(spec);
   const auto d0 = sim.diagnostics();
   ASSERT_EQ(d0.fluid, sph::test::short_runs() ? 192u : 1600u);

@@ -20,6 +20,7 @@
 #include "core/scene/scene_parser.hpp"
 #include "tests/support/brute_force_sweep.hpp"
 #include "tests/support/physics_helpers.hpp"
+#include "tests/support/still_tank_run.hpp"
 #include "tests/support/test_scale.hpp"
 
 namespace {
@@ -362,50 +363,18 @@ TEST(BufferedLevels, BandMarksEqualTheBruteForce) {
   EXPECT_GT(mixed, 10u);  // and the levels mixed where x < 3
 }
 
-struct TankRun {
-  double window_speed = 0.0;       // the largest speed of each step, averaged over the steps in [end / 3, end]
-  std::size_t fluid_after_last = 0, fluid_end = 0;  // active fluid after the last pass and at the end
-  double largest_pass_change = 0.0;  // |E after - E before| of any pass
-  double e0 = 0.0;
-  std::size_t outside = 0;
-  std::size_t passes = 0;
-  int coarse_bin = -1;  // the finest time bin of an active level-0 particle at the end
-  int fine_bin = -1;    // the coarsest time bin of an active particle of the finest level at the end
-};
+using test::TankRun;
 
 TankRun run_tank(const refine::RefinementSettings* r, double end, TimeStepping stepping) {
   TankSpec spec;
   spec.stepping = stepping;
   Simulation sim = make_still_tank(spec);
   if (r != nullptr) refine::add_refinement_stage(sim, *r);
-  TankRun out;
-  out.e0 = sim.diagnostics().total_energy();
-  double speed_sum = 0.0;
-  std::size_t speed_steps = 0;
-  while (sim.time() < end) {
-    sim.step();
-    const Diagnostics before = sim.diagnostics();
-    if (sim.time() >= end / 3.0) {
-      speed_sum += before.max_speed;
-      ++speed_steps;
-    }
-    const std::size_t stored = sim.store().size();
-    sim.run_stages();
-    if (sim.store().size() != stored) {
-      const Diagnostics after = sim.diagnostics();
-      out.largest_pass_change = std::max(out.largest_pass_change, std::abs(after.total_energy() - before.total_energy()));
-      out.fluid_after_last = after.fluid;
-      ++out.passes;
-    }
-  }
-  out.window_speed = speed_sum / static_cast<double>(std::max<std::size_t>(speed_steps, 1));
-  out.fluid_end = sim.diagnostics().fluid;
+  TankRun out = test::measure_still_tank(sim, end);
   const auto& s = sim.store();
   const int finest = r != nullptr ? r->max_level : 0;
   for (std::size_t i = 0; i < s.size(); ++i) {
-    if (s.kind[i] != Kind::fluid) continue;
-    if (!sim.settings().geometry.in_fluid_domain(s.x[i])) ++out.outside;
-    if (is_passive(s.role[i])) continue;
+    if (s.kind[i] != Kind::fluid || is_passive(s.role[i])) continue;
     if (s.level[i] == 0) out.coarse_bin = std::max(out.coarse_bin, s.bin[i]);
     if (s.level[i] == finest) out.fine_bin = out.fine_bin < 0 ? s.bin[i] : std::min(out.fine_bin, s.bin[i]);
   }
@@ -431,13 +400,7 @@ class BufferedStillTank : public ::testing::TestWithParam<TankCase> {};
 TEST_P(BufferedStillTank, StaysAsStillAsTheUnrefinedTank) {
   const TankCase& c = GetParam();
   const double end = test::short_runs() ? 4.0 : 10.0;
-  refine::RefinementSettings r;
-  r.criterion = refine::CriterionKind::zone;
-  r.zone = Box2{c.lo, c.hi};
-  r.pattern = c.pattern;
-  r.check_interval = 100;
-  r.max_level = c.levels;
-  r.coupling = LevelCoupling::buffered;
+  const refine::RefinementSettings r = test::buffered_zone(Box2{c.lo, c.hi}, c.pattern, c.levels);
   const TankRun plain = run_tank(nullptr, end, c.stepping);
   const TankRun refined = run_tank(&r, end, c.stepping);
   RecordProperty("window_speed_over_unrefined", std::to_string(refined.window_speed / plain.window_speed));

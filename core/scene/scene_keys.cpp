@@ -264,6 +264,10 @@ const Section<Scene>& scene_section() {
               .means("the initial fluid"));
     d.add(value<Scene>("h_factor", member(&Scene::h_factor))
               .range(Range::between(0.5, 3))
+              .note("in 3D the cubic lattice's alternating-layer shear mode grows under pressure for h_factor in "
+                    "about 0.5-0.9, 1.03-1.26, 1.51-1.70, 1.79-2.19 and 2.52-3, 1.2 among them: still water stays still there only "
+                    "while nothing disturbs it, and a refinement pass does (docs/METHOD.md, \"Three dimensions: a "
+                    "lattice mode\"); 1.3 is stable")
               .means("smoothing length `h = h_factor * d` (PHYSICS.md `r`)"));
     d.add(object<Scene>("material", member(&Scene::material), material_section)
               .required()

@@ -160,8 +160,9 @@ const S<Refinement>& refinement_section() {
               .means("families merge back where the flow no longer needs them"));
     d.add(value<Refinement>("coupling", member(&Refinement::coupling))
               .only_for({"zone", "velocity"})
-              .note("`buffered`: 2D, one process, no static refinement, coarsening by families only, every "
-                    "fluid region at one level; fine fluid that leaves the zone stays fine until coarsening merges it "
+              .note("`buffered`: one process, no static refinement, coarsening by families only, every fluid "
+                    "region at one level, in 3D an `h_factor` where the lattice's layer shear mode is stable (1.3, not "
+                    "1.2; docs/METHOD.md, \"Three dimensions: a lattice mode\"); fine fluid that leaves the zone stays fine until coarsening merges it "
                     "back, and coarse fluid it mixes with is refined; in a violent flow the energy can grow between "
                     "passes, and a run whose fine fluid meets an impact can stop (docs/METHOD.md, \"Buffered levels\")")
               .means("how levels interact: every pair (`mixed`, the paper's), or each level with its own, its lattice "

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/kernel.hpp"
 #include "core/scene/scene_parser.hpp"
 #include "core/scene/scene_rules.hpp"
 #include "core/scene/scene_schema.hpp"
@@ -200,9 +201,13 @@ void validate_scene(const Scene& s) {
         fail(p + ".coarsening.groups", "\"buffered\" merges a shadow's own daughters back into it: use \"family\" (or "
                                        "coupling \"mixed\")");
       }
-      if (dimension(s) == 3) {
-        fail(p + ".coupling", "\"buffered\" is 2D only so far: the 3D still tank with a buffered zone is not yet still "
-                              "(docs/METHOD.md, \"Buffered levels\"); use \"mixed\"");
+      // In 3D the cubic lattice's alternating-layer shear mode grows under pressure at some h / d (1.2 among them), and
+      // a split seeds it: the point of buffered levels, still water that stays still, then fails whatever the coupling
+      // does (docs/METHOD.md, "Three dimensions: a lattice mode").
+      if (dimension(s) == 3 && CubicSpline<3>::layer_shear_stiffness(s.h_factor) < 0.0) {
+        fail("h_factor", num(s.h_factor) + " with \"buffered\" levels in 3D: at this h / d the cubic lattice's "
+                         "alternating-layer shear mode grows under pressure, and a split sets it off (docs/METHOD.md, "
+                         "\"Three dimensions: a lattice mode\"); use 1.3, where it is stable");
       }
       // No pair mixes levels, so particles of different levels that no split made (a static refinement, fluid regions
       // set up at other levels) would not meet at all: they have no shadows or buffer particles between them.
