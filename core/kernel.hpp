@@ -82,11 +82,35 @@ struct CubicSpline {
   /// 0.5-0.9, 1.03-1.26, 1.51-1.70, 1.79-2.19 and 2.52-3 (the paper's 1.2 among them), in 2D in 0.5-0.81, 0.95-1.20,
   /// 1.52-2.10 and 2.43-3 (at 1.2 S is +0.002); a refinement pass seeds the mode (docs/METHOD.md, "Three dimensions: a lattice mode").
   static double layer_shear_stiffness(double h_over_d) {
+    double sum = 0.0;
+    for_each_lattice_point(h_over_d, [&](const int (&idx)[3], double r) {
+      if (idx[D - 1] % 2 == 0) return;  // the layers that move with the particle at the origin
+      const double e0 = static_cast<double>(idx[0]) / r;  // the first axis' share of the unit vector
+      // d^2W/dx_0^2 = W'' e0^2 + (W' / r) (1 - e0^2)
+      sum += 2.0 * (second_derivative(r, h_over_d) * e0 * e0 + derivative(r, h_over_d) / r * (1.0 - e0 * e0));
+    });
+    return sum;
+  }
+
+  /// h sum_j d^D |grad W(x_j, h)| over the points x_j != 0 of a square (cubic) lattice of spacing d, for
+  /// h = h_over_d d: the kernel-gradient sum a particle on its own lattice sees, in units of 1/h (it does not
+  /// depend on d). 2D at h = 1.2 d: 1.964; 3D at h = 1.2 d: 2.651.
+  static double lattice_gradient_sum(double h_over_d) {
+    double sum = 0.0;
+    for_each_lattice_point(h_over_d, [&](const int (&)[3], double r) { sum += std::abs(derivative(r, h_over_d)); });
+    return sum * h_over_d;
+  }
+
+ private:
+  /// f(idx, r) for every point idx != 0 of the square (cubic) lattice of spacing 1 with |idx_k| <= ceil(2 h_over_d) (the
+  /// kernel's support at h = h_over_d, and the cube's corners beyond it), r = |idx|; in a fixed order, the first axis
+  /// fastest. (idx[k] is 0 for k >= D.)
+  template <class F>
+  static void for_each_lattice_point(double h_over_d, F&& f) {
     const int n = static_cast<int>(std::ceil(2.0 * h_over_d));
     const int side = 2 * n + 1;
     int count = 1;
     for (int k = 0; k < D; ++k) count *= side;
-    double sum = 0.0;
     for (int c = 0; c < count; ++c) {
       int rest = c;
       int idx[3] = {0, 0, 0};
@@ -96,36 +120,8 @@ struct CubicSpline {
         rest /= side;
         r2 += static_cast<double>(idx[k] * idx[k]);
       }
-      if (idx[D - 1] % 2 == 0) continue;  // the layers that move with the particle at the origin (and itself)
-      const double r = std::sqrt(r2);
-      const double e0 = static_cast<double>(idx[0]) / r;  // the first axis' share of the unit vector
-      // d^2W/dx_0^2 = W'' e0^2 + (W' / r) (1 - e0^2)
-      sum += 2.0 * (second_derivative(r, h_over_d) * e0 * e0 + derivative(r, h_over_d) / r * (1.0 - e0 * e0));
+      if (r2 > 0.0) f(idx, std::sqrt(r2));
     }
-    return sum;
-  }
-
-  /// h sum_j d^D |grad W(x_j, h)| over the points x_j != 0 of a square (cubic) lattice of spacing d, for
-  /// h = h_over_d d: the kernel-gradient sum a particle on its own lattice sees, in units of 1/h (it does not
-  /// depend on d). 2D at h = 1.2 d: 1.964; 3D at h = 1.2 d: 2.651.
-  static double lattice_gradient_sum(double h_over_d) {
-    const int n = static_cast<int>(std::ceil(2.0 * h_over_d));
-    double sum = 0.0;
-    int idx[3] = {0, 0, 0};
-    const int side = 2 * n + 1;
-    int count = 1;
-    for (int k = 0; k < D; ++k) count *= side;
-    for (int c = 0; c < count; ++c) {
-      int rest = c;
-      double r2 = 0.0;
-      for (int k = 0; k < D; ++k) {
-        idx[k] = rest % side - n;
-        rest /= side;
-        r2 += static_cast<double>(idx[k] * idx[k]);
-      }
-      sum += std::abs(derivative(std::sqrt(r2), h_over_d));
-    }
-    return sum * h_over_d;
   }
 };
 

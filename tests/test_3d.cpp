@@ -46,20 +46,32 @@ sph::Tank3Spec test_tank(double h_factor) {
 // ---------------------------------------------------------------------------------------------------
 // A lattice mode of 3D still water (docs/METHOD.md, "Three dimensions: a lattice mode")
 
-/// The amplitude of the alternating-layer shear mode in the tank: the fluid's x-velocity projected on the seed's
-/// shape, (-1)^layer sin(2 pi x / L) (layer = the lattice row in z; the sine vanishes at the end walls).
-double layer_shear_amplitude(sph::SimulationT<3>& sim, const sph::Tank3Spec& spec, double seed = 0.0) {
+/// The alternating-layer shear mode's shape at x: (-1)^layer sin(2 pi x / L) along x (layer = the lattice row in z;
+/// the sine vanishes at the end walls).
+double layer_shear_shape(const Vec3& x, const sph::Tank3Spec& spec) {
+  const long layer = std::lround(x[2] / spec.spacing - 0.5);
+  return (layer % 2 == 0 ? 1.0 : -1.0) * std::sin(2.0 * std::numbers::pi * x[0] / spec.length);
+}
+
+/// Adds `seed` times the mode to every fluid velocity the integrator holds (v, the half-step and the step-start copy).
+void seed_layer_shear(sph::SimulationT<3>& sim, const sph::Tank3Spec& spec, double seed) {
   auto& s = sim.store();
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] != Kind::fluid) continue;
+    const double u = seed * layer_shear_shape(s.x[i], spec);
+    s.v[i][0] += u;
+    s.vh[i][0] += u;
+    s.v_open[i][0] += u;
+  }
+}
+
+/// The mode's amplitude: the fluid's x-velocity projected on its shape.
+double layer_shear_amplitude(const sph::SimulationT<3>& sim, const sph::Tank3Spec& spec) {
+  const auto& s = sim.store();
   double vu = 0.0, uu = 0.0;
   for (std::size_t i = 0; i < s.size(); ++i) {
     if (s.kind[i] != Kind::fluid) continue;
-    const long layer = std::lround(s.x[i][2] / spec.spacing - 0.5);
-    const double u = (layer % 2 == 0 ? 1.0 : -1.0) * std::sin(2.0 * std::numbers::pi * s.x[i][0] / spec.length);
-    if (seed != 0.0) {  // the seed: the mode's velocity in every velocity the integrator holds
-      s.v[i][0] += seed * u;
-      s.vh[i][0] += seed * u;
-      s.v_open[i][0] += seed * u;
-    }
+    const double u = layer_shear_shape(s.x[i], spec);
     vu += s.v[i][0] * u;
     uu += u * u;
   }
@@ -67,12 +79,14 @@ double layer_shear_amplitude(sph::SimulationT<3>& sim, const sph::Tank3Spec& spe
 }
 
 // The still tank at h = 1.2 d and 1.3 d, seeded with the alternating-layer shear mode at 1 mm/s. Where the mode's
-// stiffness (CubicSpline::layer_shear_stiffness) is negative it grows at up to sqrt(-2 S g H) / d, the rate at the
-// floor's pressure rho g H (19 /s at h = 1.2 d), and at sqrt(-S g H) / d (14 /s) at mid-depth: over 0.6 s the lower
-// half alone would grow it by e^8. Within 0.6 s it must reach ten times the seed (a bound far below that growth, so that
-// the seed's share in the growing mode, which the tank's other motions take part of, does not decide it), and between
-// two samples it may not grow faster than the floor's rate. Where the stiffness is positive the mode is stable, and the
-// seed must not grow at all. (The tank without a seed stays still at both: StillTank3D.)
+// stiffness (CubicSpline::layer_shear_stiffness) is negative it grows, at most at sqrt(-2 S g H) / d, the rate at the
+// floor's pressure rho g H (19 /s at h = 1.2 d; 14 /s at mid-depth). The test asks what tells an unstable mode from a
+// stable one: at 1.2 d the amplitude must grow by an order of magnitude (ten times the seed) within 0.6 s, and once past
+// the seed never faster between two samples than the floor's rate; at 1.3 d, where the mode is stable, it must never
+// exceed the seed. (Measured: at 1.2 d the amplitude first falls to 0.14 of the seed, the seed's share in the tank's
+// other motions, then grows at 9.7 /s from 0.2 to 0.5 s, slower than the analysis, which leaves out the viscosity, and
+// peaks at 16x at 0.55 s, when the water is stirred; at 1.3 d it stays within 0.73 of the seed. The run is bitwise the
+// same at any thread count.) The tank without a seed stays still at both: StillTank3D.
 TEST(LayerShearMode3D, GrowsWhereItsStiffnessIsNegativeAndNotWhereItIsPositive) {
   ASSERT_LT(sph::CubicSpline<3>::layer_shear_stiffness(1.2), 0.0);
   ASSERT_GT(sph::CubicSpline<3>::layer_shear_stiffness(1.3), 0.0);
@@ -84,7 +98,8 @@ TEST(LayerShearMode3D, GrowsWhereItsStiffnessIsNegativeAndNotWhereItIsPositive) 
     sph::SimulationT<3> sim = sph::make_still_tank(spec);
     const double stiffness = sph::CubicSpline<3>::layer_shear_stiffness(h);
     const double floor_rate = std::sqrt(std::max(0.0, -2.0 * stiffness * kG * spec.depth)) / spec.spacing;
-    const double a0 = layer_shear_amplitude(sim, spec, seed);
+    seed_layer_shear(sim, spec, seed);
+    const double a0 = layer_shear_amplitude(sim, spec);
     ASSERT_NEAR(a0, seed, 1e-12);
     std::vector<double> amplitude{a0};
     const double end = sph::test::short_runs() ? 0.1 : 0.6;
@@ -102,6 +117,8 @@ TEST(LayerShearMode3D, GrowsWhereItsStiffnessIsNegativeAndNotWhereItIsPositive) 
     for (double a : amplitude) series += " " + std::to_string(a);
     SCOPED_TRACE("amplitude every 0.05 s:" + series);
     RecordProperty(h < 1.25 ? "largest_over_seed_h1_2" : "largest_over_seed_h1_3", std::to_string(largest / seed));
+    RecordProperty(h < 1.25 ? "fastest_growth_h1_2" : "fastest_growth_h1_3", std::to_string(fastest));
+    RecordProperty(h < 1.25 ? "amplitudes_h1_2" : "amplitudes_h1_3", series);
     if (sph::test::short_runs()) continue;  // 0.1 s: a smoke run under the sanitizer
     if (stiffness < 0.0) {
       EXPECT_GE(largest, 10.0 * seed);
