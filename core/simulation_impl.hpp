@@ -446,7 +446,10 @@ StepInfo SimulationT<D>::step(double dt_cap) {
           },
           [](const SmoothingRange& a, const SmoothingRange& b) { return a.merged(b); });
     }
-    if (buffered()) refine::tie_buffers(store_);
+    if (buffered()) {
+      refine::tie_buffers(store_);
+      refine::keep_passive_inside_walls(store_, settings_.geometry.walls());
+    }
     // Fluid that left through an open top (container.outflow = "remove") goes now, before the neighbour search
     // and the watchdog. A removal renumbers the particles, so the counts and range of the loop above are redone.
     bool renumbered = false;

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <unordered_map>
 #include <unordered_set>
 #include <utility>
 
@@ -37,7 +38,28 @@ void tie_buffers(ParticleStore<D>& store) {
 }
 
 template <int D>
-std::size_t prepare_buffered_marks(ParticleStore<D>& store, std::vector<std::uint8_t>& marks, int max_level) {
+void flip_daughter(ParticleStore<D>& s, std::size_t host, std::size_t k, const DaughterDensityIn<D>& density) {
+  s.v[k] = s.v[host];
+  s.vh[k] = s.vh[host];
+  s.v_open[k] = s.v_open[host];
+  s.a[k] = s.a[host];
+  s.full_a[k] = s.full_a[host];
+  s.kick[k] = s.kick[host];
+  s.jerk[k] = s.jerk[host];
+  s.drho[k] = s.drho[host];
+  s.full_drho[k] = s.full_drho[host];
+  s.kick_rho[k] = s.kick_rho[host];
+  s.density_jerk[k] = s.density_jerk[host];
+  const double change = daughter_density_gradient<D>(density, s.rho[host], Vec<D>::Zero()).dot(s.tie[k]);
+  s.rho[k] = s.rho[host] + change;
+  s.rhoh[k] = s.rhoh[host] + change;
+  s.rho_open[k] = s.rho_open[host] + change;
+  s.p[k] = density.eos.pressure(s.rho[k]);
+}
+
+template <int D>
+std::size_t prepare_buffered_marks(ParticleStore<D>& store, std::vector<std::uint8_t>& marks, int max_level,
+                                   const DaughterDensityIn<D>& density) {
   const std::size_t n = store.size();
   const auto fluid = [&](std::size_t i) { return store.kind[i] == Kind::fluid; };
   std::unordered_set<ParticleId> parents;  // ids of the particles that have daughters
@@ -66,21 +88,23 @@ std::size_t prepare_buffered_marks(ParticleStore<D>& store, std::vector<std::uin
     }
   }
   for (std::size_t i = 0; i < n; ++i) marks[i] = marks[i] || mixed[i];
-  // A marked host: its zone now covers it. It turns into a shadow, and its daughters take over as active.
-  std::unordered_set<ParticleId> flipped;
+  // A marked host: its zone now covers it. It turns into a shadow, and its daughters take over as active with its
+  // state, as a split's daughters take their parent's (flip_daughter).
+  std::unordered_map<ParticleId, std::size_t> flipped;  // host id -> index
   for (std::size_t i = 0; i < n; ++i) {
     if (marks[i] && fluid(i) && store.level[i] < max_level && store.role[i] == Role::host) {
       store.role[i] = Role::shadow;
-      flipped.insert(store.id[i]);
+      flipped.emplace(store.id[i], i);
     }
   }
   if (!flipped.empty()) {
     for (std::size_t i = 0; i < n; ++i) {
-      if (fluid(i) && store.role[i] == Role::buffer && has_parent(store.id[i]) &&
-          flipped.count(parent_id<D>(store.id[i])) != 0) {
-        store.role[i] = Role::active;
-        store.origin[i] = Origin::fresh_split;  // its family does not merge at the next check
-      }
+      if (!(fluid(i) && store.role[i] == Role::buffer && has_parent(store.id[i]))) continue;
+      const auto host = flipped.find(parent_id<D>(store.id[i]));
+      if (host == flipped.end()) continue;
+      store.role[i] = Role::active;
+      store.origin[i] = Origin::fresh_split;  // its family does not merge at the next check
+      flip_daughter(store, host->second, i, density);
     }
   }
   for (std::size_t i = 0; i < n; ++i) {
@@ -319,10 +343,36 @@ RetractResultIn<D> retract_buffered(ParticleStore<D>& store, const std::vector<s
   return result;
 }
 
+template <int D>
+std::size_t keep_passive_inside_walls(ParticleStore<D>& store, const std::vector<Wall<D>>& walls) {
+  auto view = store.view();
+  return par::accumulate(
+      view.n, std::size_t{0},
+      [&](std::size_t& moved, std::size_t i) {
+        if (view.kind[i] != Kind::fluid || !is_passive(view.role[i])) return;
+        const double margin = passive_wall_margin(view.d[i]);
+        bool any = false;
+        for (const Wall<D>& w : walls) {
+          const double dist = w.signed_distance(view.x[i]);
+          if (dist >= margin || dist < -view.d[i] || !w.projects_onto(view.x[i])) continue;
+          view.x[i] += (margin - dist) * w.n;
+          any = true;
+        }
+        if (any) ++moved;
+      },
+      [](std::size_t a, std::size_t b) { return a + b; });
+}
+
+template std::size_t keep_passive_inside_walls<2>(ParticleStore<2>&, const std::vector<Wall<2>>&);
+template std::size_t keep_passive_inside_walls<3>(ParticleStore<3>&, const std::vector<Wall<3>>&);
 template void tie_buffers<2>(ParticleStore<2>&);
 template void tie_buffers<3>(ParticleStore<3>&);
-template std::size_t prepare_buffered_marks<2>(ParticleStore<2>&, std::vector<std::uint8_t>&, int);
-template std::size_t prepare_buffered_marks<3>(ParticleStore<3>&, std::vector<std::uint8_t>&, int);
+template std::size_t prepare_buffered_marks<2>(ParticleStore<2>&, std::vector<std::uint8_t>&, int,
+                                                const DaughterDensityIn<2>&);
+template std::size_t prepare_buffered_marks<3>(ParticleStore<3>&, std::vector<std::uint8_t>&, int,
+                                                const DaughterDensityIn<3>&);
+template void flip_daughter<2>(ParticleStore<2>&, std::size_t, std::size_t, const DaughterDensityIn<2>&);
+template void flip_daughter<3>(ParticleStore<3>&, std::size_t, std::size_t, const DaughterDensityIn<3>&);
 template RetractResultIn<2> retract_buffered<2>(ParticleStore<2>&, const std::vector<std::uint8_t>&, const Geometry<2>&,
                                                 double, double, const std::function<bool(const Vec<2>&, const Vec<2>&)>&,
                                                 int);

@@ -29,6 +29,7 @@
 #include "core/equation_of_state.hpp"
 #include "core/kernel.hpp"
 #include "core/particle_store.hpp"
+#include "core/refinement/split_pass.hpp"
 #include "core/refinement/merge_pass.hpp"
 #include "parallel/parallel_for.hpp"
 
@@ -131,6 +132,22 @@ void interpolate_passive(const ParticleView<D>& s, const CellGrid<D>& grid, cons
 template <int D>
 void tie_buffers(ParticleStore<D>& store);
 
+/// How far inside every wall a passive particle of spacing d is kept (keep_passive_inside_walls): a quarter of its
+/// spacing. Half the distance at which particles of that spacing sit at a wall at rest (d / 2, where the set-up and
+/// the wall rule put them), so a still lattice is never moved; and the particle and its ghost image stay half a
+/// spacing apart, as close as the fluid's own compressed neighbours, not on top of each other.
+inline double passive_wall_margin(double spacing) { return 0.25 * spacing; }
+
+/// Keeps every passive fluid particle at least passive_wall_margin(d) inside each wall it is near (projects onto,
+/// and lies less than the margin inside or behind by at most its spacing), moving it along the wall's normal. Called
+/// after each drift, after tie_buffers. Nothing else holds a passive particle in the domain: no force acts on it, a
+/// shadow moves with its fitted velocity and a buffer particle beside its host. A shadow at the edge of a thin jet up
+/// a wall, fitted from two fine particles and one ghost, took 0.8 m/s into the wall and left the domain, which
+/// stopped the dam break (docs/METHOD.md, "Buffered levels"). Passive particles are not counted, so mass, momentum
+/// and energy do not change. Returns how many it moved.
+template <int D>
+std::size_t keep_passive_inside_walls(ParticleStore<D>& store, const std::vector<Wall<D>>& walls);
+
 /// How close (in its own spacing d_l) an active particle of level l may come to an active particle of level l + 1
 /// before the pass gives its place to the finer level (prepare_buffered_marks). Each level's lattice is completed by
 /// passive particles of the other, so fluid of two levels that a flow mixes (fine particles carried out of their
@@ -145,8 +162,8 @@ inline constexpr double kIntermixReach = 0.6;
 /// Turns the criterion's marks (1: refine) into a buffered pass's (split_marked with buffered = true), on the store
 /// between steps (fluid, ghosts dropped or not):
 ///   - an active particle of level l within kIntermixReach d_l of an active particle of level l + 1 is marked;
-///   - a marked host becomes a shadow and its buffer daughters active (its zone grew over it; Origin::fresh_split):
-///     no split;
+///   - a marked host becomes a shadow and its buffer daughters active (its zone grew over it; Origin::fresh_split),
+///     with its state (flip_daughter): no split;
 ///   - a mark on a particle that is passive or already has daughters is dropped;
 ///   - an unmarked active or buffer particle of level l < max_level without daughters, within h_l + d_l (a daughter's
 ///     support 2 h_{l+1}, plus how far its own daughters sit from it) of an active particle of level l + 1, or within
@@ -154,7 +171,20 @@ inline constexpr double kIntermixReach = 0.6;
 ///     (buffer daughters).
 /// Returns the number of hosts that became shadows. Deterministic: no mark depends on the store's order.
 template <int D>
-std::size_t prepare_buffered_marks(ParticleStore<D>& store, std::vector<std::uint8_t>& marks, int max_level);
+std::size_t prepare_buffered_marks(ParticleStore<D>& store, std::vector<std::uint8_t>& marks, int max_level,
+                                   const DaughterDensityIn<D>& density);
+
+/// A host's flip, for its buffer daughter k: k takes the host's velocity and rates (v, its half-step and step-start
+/// copies, a, drho and the sweep's sums, the jerks), as a split's daughter takes its parent's, and the host's density
+/// carried along the hydrostatic gradient to k's place (daughter_density_gradient with a = 0; the host's own with the
+/// `parent` rule). So the flip keeps mass, linear momentum and kinetic energy exactly, and potential energy where the
+/// tie offsets' centroid is the host (all but wall-shifted patterns); the elastic energy changes at second order in
+/// the hydrostatic step across the family. Until 2026-12-06 a flip kept the daughters' fitted state: each pass then
+/// changed the dam break's total energy by up to 4.7e-4 E(0) (issue #15's target: 1e-6). With the gradient the
+/// host's last acceleration balanced, as a split uses, a flip inside an impact gave a family densities several per
+/// cent apart: passes changed the energy by up to 1.5e-6 E(0) (docs/METHOD.md, "Buffered levels").
+template <int D>
+void flip_daughter(ParticleStore<D>& store, std::size_t host, std::size_t k, const DaughterDensityIn<D>& density);
 
 /// How far (beyond the reach h_l + d_l at which prepare_buffered_marks gives a particle of level l its buffer
 /// daughters) the finer level's active particles must have gone before a host gives its buffer daughters up

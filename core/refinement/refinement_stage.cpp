@@ -84,7 +84,9 @@ bool RefinementStageIn<D>::after_step(SimulationT<D>& sim) {
   // apart from its siblings later would break the families and the id order of every cell.
   bool any = false;
   const bool buffered = settings_.coupling == LevelCoupling::buffered;
-  const std::size_t flips = buffered ? prepare_buffered_marks(store, marks, settings_.max_level) : 0;
+  const DaughterDensityIn<D> density{settings_.daughter_density_rule(),
+                                     sim.settings().gravity.value_or(Vec<D>::Zero()), sim.settings().eos};
+  const std::size_t flips = buffered ? prepare_buffered_marks(store, marks, settings_.max_level, density) : 0;
   for (std::size_t i = 0; i < store.size(); ++i)
     if (store.origin[i] == Origin::fresh_merge) store.origin[i] = Origin::merge;
   for (std::size_t i = 0; i < store.size(); ++i) {
@@ -97,8 +99,6 @@ bool RefinementStageIn<D>::after_step(SimulationT<D>& sim) {
     }
   }
   if (any) {
-    const DaughterDensityIn<D> density{settings_.daughter_density_rule(),
-                                       sim.settings().gravity.value_or(Vec<D>::Zero()), sim.settings().eos};
     const SplitResult r = split_marked(store, marks, settings_.pattern, settings_.rsp_k, settings_.max_level,
                                        sim.settings().geometry.walls(), sim.time(), buffered, density);
     rec.refined = r.refined;

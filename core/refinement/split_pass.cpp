@@ -80,9 +80,7 @@ SplitResult split_marked(ParticleStore<D>& store, const std::vector<std::uint8_t
     const ParticleId parent = s.id[first];
     // The parent's density, and the density gradient its last evaluation balanced (zero with the paper's rule).
     const double rho = s.rho[first], rhoh = s.rhoh[first];
-    const Vec<D> grad_rho = density.rule == DaughterDensity::pressure_gradient
-                                ? Vec<D>(rho * (density.gravity - s.a[first]) / density.eos.sound_speed_squared(rho))
-                                : Vec<D>::Zero();
+    const Vec<D> grad_rho = daughter_density_gradient(density, rho, Vec<D>(s.a[first]));
     for (std::size_t a = 0; a < children; ++a) {
       const std::size_t k = first + a;
       s.x[k] = xi + offsets[r][a];

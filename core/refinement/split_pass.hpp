@@ -28,6 +28,16 @@ struct DaughterDensityIn {
   TaitEquationOfState eos{};
 };
 
+/// The density gradient daughters are given about their parent's density rho: rho (g - a) / c^2(rho) with
+/// `pressure_gradient` (DaughterDensityIn), where a is the acceleration the parent's pressure gradient balanced along
+/// with gravity; zero with `parent`. A split passes the parent's last evaluation's acceleration; a host's flip
+/// (buffered levels, prepare_buffered_marks) passes zero, the hydrostatic part alone.
+template <int D>
+Vec<D> daughter_density_gradient(const DaughterDensityIn<D>& density, double rho, const Vec<D>& a) {
+  if (density.rule != DaughterDensity::pressure_gradient) return Vec<D>::Zero();
+  return rho * (density.gravity - a) / density.eos.sound_speed_squared(rho);
+}
+
 struct SplitResult {
   std::size_t refined = 0;  // particles split
   std::size_t shifted = 0;  // patterns shifted inward by the wall rule (centroid moved)

@@ -170,7 +170,8 @@ const S<Refinement>& refinement_section() {
     d.add(value<Refinement>("daughter_density", member(&Refinement::daughter_density))
               .default_text("`pressure_gradient` with `buffered`, `parent` with `mixed`")
               .means("the daughters' density: the parent's (`parent`, the paper's), or the parent's carried to each "
-                     "daughter along the pressure gradient its momentum balance gives (`pressure_gradient`, "
+                     "daughter along the pressure gradient its momentum balance gives (`pressure_gradient`; where a "
+                     "buffered host hands its place to its buffer daughters, the hydrostatic gradient alone, "
                      "docs/METHOD.md)"));
     return d;
   }();
