@@ -433,19 +433,26 @@ INSTANTIATE_TEST_SUITE_P(Zones, BufferedStillTank,
 /// tie_buffers against the brute force: after the hosts move (each by its own displacement), every buffer particle
 /// sits at its host's place plus its tie, the host found by a scan of the whole store, level by level, so that a
 /// buffer particle whose host is a buffer particle follows it.
-TEST(BufferedLevels, BufferParticlesFollowTheirHostsAsTheBruteForcePlacesThem) {
+/// The still tank with the AAP zone `zone` at max_level levels, buffered, checked every 50 steps, after `steps` steps:
+/// a pass at step 50 (and 100), so hosts and their buffer particles are in the store.
+Simulation refined_still_tank(const Box2& zone, int max_level, int steps) {
   refine::RefinementSettings r;
   r.criterion = refine::CriterionKind::zone;
-  r.zone = Box2{Vec<2>(0, 3), Vec<2>(4, 7)};
+  r.zone = zone;
   r.check_interval = 50;
-  r.max_level = 2;
+  r.max_level = max_level;
   r.coupling = LevelCoupling::buffered;
   Simulation sim = make_still_tank(TankSpec{});
   refine::add_refinement_stage(sim, r);
-  for (int k = 0; k < 120; ++k) {
+  for (int k = 0; k < steps; ++k) {
     sim.step();
     sim.run_stages();
   }
+  return sim;
+}
+
+TEST(BufferedLevels, BufferParticlesFollowTheirHostsAsTheBruteForcePlacesThem) {
+  Simulation sim = refined_still_tank(Box2{Vec<2>(0, 3), Vec<2>(4, 7)}, 2, 120);
   ParticleStore<2> s = sim.store();
   std::size_t nested = 0, buffers = 0;
   for (std::size_t i = 0; i < s.size(); ++i) {
@@ -524,18 +531,7 @@ TEST(BufferedLevels, PassiveParticlesStayInsideTheWalls) {
 /// within issue #15's 1e-6 of E(0) (the gradient's second-order change: per family about m c^2 (g d / 4 c^2)^2, some
 /// 1e-10 of E(0) here).
 TEST(BufferedLevels, AFlipGivesTheDaughtersTheirHostsStateAndKeepsTheEnergy) {
-  refine::RefinementSettings r;
-  r.criterion = refine::CriterionKind::zone;
-  r.zone = Box2{Vec<2>(10, 3), Vec<2>(15, 7)};
-  r.check_interval = 50;
-  r.max_level = 1;
-  r.coupling = LevelCoupling::buffered;
-  Simulation sim = make_still_tank(TankSpec{});
-  refine::add_refinement_stage(sim, r);
-  for (int k = 0; k < 60; ++k) {
-    sim.step();
-    sim.run_stages();
-  }
+  Simulation sim = refined_still_tank(Box2{Vec<2>(10, 3), Vec<2>(15, 7)}, 1, 60);
   ParticleStore<2>& s = sim.store();
   // The buffer particles' fitted state, made unlike their hosts' (as in a shearing flow).
   for (std::size_t i = 0; i < s.size(); ++i) {
