@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
+#include <set>
 #include <vector>
 
 #include "core/case_builder.hpp"
@@ -575,6 +576,43 @@ TEST(BufferedLevels, AFlipGivesTheDaughtersTheirHostsStateAndKeepsTheEnergy) {
   EXPECT_NEAR(after.kinetic, before.kinetic, 1e-12 * before.kinetic);
   EXPECT_LE(std::abs(after.total_energy() - before.total_energy()), 1e-6 * std::abs(before.total_energy()));
   EXPECT_GT(std::abs(after.total_energy() - before.total_energy()), 0.0);  // the gradient did change the densities
+}
+
+/// A flip two levels deep: a level-0 host whose level-1 buffer daughters host level-2 buffer particles. When the host
+/// flips, a daughter with buffer daughters of its own becomes their host (so tie_buffers keeps them beside it, and a
+/// later flip of its own can hand them its place), the others active. (Until 2026-12-06 all turned active, and the
+/// level-2 buffer particles of an active parent were neither tied nor ever flipped.)
+TEST(BufferedLevels, AFlippedDaughterWithBufferDaughtersBecomesTheirHost) {
+  Simulation sim = refined_still_tank(Box2{Vec<2>(0, 3), Vec<2>(4, 7)}, 2, 120);
+  ParticleStore<2>& s = sim.store();
+  std::set<ParticleId> hosting;  // level-1 buffer particles with daughters
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] == Kind::fluid && s.level[i] == 2 && s.role[i] == Role::buffer) hosting.insert(refine::parent_id(s.id[i]));
+  }
+  std::vector<std::uint8_t> marks(s.size(), 0);
+  std::set<ParticleId> flipped;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] == Kind::fluid && s.level[i] == 0 && s.role[i] == Role::host) {
+      marks[i] = 1;
+      flipped.insert(s.id[i]);
+    }
+  }
+  const refine::DaughterDensityIn<2> density{refine::DaughterDensity::pressure_gradient, Vec<2>(0, -9.81),
+                                             sim.settings().eos};
+  ASSERT_EQ(refine::prepare_buffered_marks(s, marks, 2, density), flipped.size());
+  std::size_t hosts = 0, active = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] != Kind::fluid || s.level[i] != 1 || !flipped.count(refine::parent_id(s.id[i]))) continue;
+    if (hosting.count(s.id[i]) != 0) {
+      EXPECT_EQ(s.role[i], Role::host) << s.id[i];
+      ++hosts;
+    } else {
+      EXPECT_EQ(s.role[i], Role::active) << s.id[i];
+      ++active;
+    }
+  }
+  EXPECT_GT(hosts, 10u);  // the case is there
+  EXPECT_GT(active, 10u);
 }
 
 // Issue #15 in a flow: the dam break (cases/dam_break_aap.json) with buffered levels, in the right-hand corner (a zone

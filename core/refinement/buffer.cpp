@@ -102,7 +102,8 @@ std::size_t prepare_buffered_marks(ParticleStore<D>& store, std::vector<std::uin
       if (!(fluid(i) && store.role[i] == Role::buffer && has_parent(store.id[i]))) continue;
       const auto host = flipped.find(parent_id<D>(store.id[i]));
       if (host == flipped.end()) continue;
-      store.role[i] = Role::active;
+      // A daughter with buffer daughters of its own (a level-1 buffer particle hosting level 2) becomes their host.
+      store.role[i] = parents.count(store.id[i]) != 0 ? Role::host : Role::active;
       store.origin[i] = Origin::fresh_split;  // its family does not merge at the next check
       flip_daughter(store, host->second, i, density);
     }

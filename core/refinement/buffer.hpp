@@ -163,7 +163,7 @@ inline constexpr double kIntermixReach = 0.6;
 /// between steps (fluid, ghosts dropped or not):
 ///   - an active particle of level l within kIntermixReach d_l of an active particle of level l + 1 is marked;
 ///   - a marked host becomes a shadow and its buffer daughters active (its zone grew over it; Origin::fresh_split),
-///     with its state (flip_daughter): no split;
+///     with its state (flip_daughter), or hosts where they have buffer daughters of their own: no split;
 ///   - a mark on a particle that is passive or already has daughters is dropped;
 ///   - an unmarked active or buffer particle of level l < max_level without daughters, within h_l + d_l (a daughter's
 ///     support 2 h_{l+1}, plus how far its own daughters sit from it) of an active particle of level l + 1, or within
