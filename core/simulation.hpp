@@ -191,6 +191,7 @@ class SimulationT {
   void build_neighbours(const SmoothingRange& hr);
 
   Settings settings_;
+  std::vector<Wall<D>> walls_;  // settings_.geometry.walls(), built once (the settings do not change after construction)
   ParticleStore<D> store_;
   CellGrid<D> grid_;
   std::optional<Ghosts> ghosts_;

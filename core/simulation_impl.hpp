@@ -19,9 +19,10 @@ namespace sph {
 template <int D>
 SimulationT<D>::SimulationT(Settings settings)
     : settings_(std::move(settings)),
+      walls_(settings_.geometry.walls()),
       integrator_(settings_.stepping, settings_.eos, settings_.bin_jump, settings_.predictor) {
   if (settings_.ghosts) {
-    ghosts_.emplace(settings_.geometry.walls(), *settings_.ghosts, settings_.ghost_pressure,
+    ghosts_.emplace(walls_, *settings_.ghosts, settings_.ghost_pressure,
                     settings_.gravity.value_or(Vec<D>::Zero()), settings_.eos);
   }
   sweep_ = make_sweep(settings_);
@@ -448,7 +449,7 @@ StepInfo SimulationT<D>::step(double dt_cap) {
     }
     if (buffered()) {
       refine::tie_buffers(store_);
-      refine::keep_passive_inside_walls(store_, settings_.geometry.walls());
+      refine::keep_passive_inside_walls(store_, walls_);
     }
     // Fluid that left through an open top (container.outflow = "remove") goes now, before the neighbour search
     // and the watchdog. A removal renumbers the particles, so the counts and range of the loop above are redone.
