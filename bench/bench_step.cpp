@@ -80,6 +80,24 @@ void BM_Sweep_Rebin(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * fluid));
 }
 
+// The binned loop of a per-level run's inner evaluations (every particle due, in bin 0 of a store allowed two bins)
+// against the single-rate loop on the same store and effects (BM_Sweep_ViscosityAndLennardJones): what the binned
+// loop costs per pair on its own, with the same pairs and sums (issue #16).
+void BM_Sweep_Binned(benchmark::State& state) {
+  omp_set_num_threads(static_cast<int>(state.range(1)));
+  DamBreakSpec spec = block(static_cast<std::size_t>(state.range(0)));
+  spec.viscosity = true;
+  spec.lennard_jones = true;
+  Simulation sim = make_dam_break(spec);
+  for (int k = 0; k < 20; ++k) sim.step();
+  const auto sweep = make_sweep(sim.settings());
+  Activity act;
+  act.bin_cap = 1;
+  const std::size_t fluid = sim.diagnostics().fluid;
+  for (auto _ : state) benchmark::DoNotOptimize(sweep->run(sim.store().view(), sim.grid(), act));
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * fluid));
+}
+
 void BM_Sweep_PressureOnly(benchmark::State& s) { BM_Sweep_Effects(s, false, false); }
 void BM_Sweep_Viscosity(benchmark::State& s) { BM_Sweep_Effects(s, true, false); }
 void BM_Sweep_LennardJones(benchmark::State& s) { BM_Sweep_Effects(s, false, true); }
@@ -154,6 +172,7 @@ BENCHMARK(BM_Sweep_Viscosity)->Args({100000, 1})->Args({100000, 2})->Unit(benchm
 BENCHMARK(BM_Sweep_LennardJones)->Args({100000, 1})->Args({100000, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Sweep_ViscosityAndLennardJones)->Args({100000, 1})->Args({100000, 2})
     ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Sweep_Binned)->Args({100000, 1})->Args({100000, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Sweep_Rebin)->Args({100000, 1})->Args({100000, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace

@@ -15,10 +15,13 @@
 // bin_cap = 0 (one global step) every weight is 1 and the sweep is the plain one.
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <stdexcept>
 #include <tuple>
+#include <type_traits>
 
 #include "core/cell_grid.hpp"
 #include "core/effects/pair.hpp"
@@ -169,19 +172,22 @@ class PairSweep {
           const bool due = !Binned || bi >= act.active_bin;
           PairSums<D> acc;
           PairSums<D> next;  // with act.rebin: the sums weighted by the next bins
-          // A due particle's pairs by their bin b_ij (binned loop), each class weighted 2^-b_ij as in acc; acc is then
-          // their sum in class order, and the full-weight rates (full_a) sum them at 2^b_ij. A particle whose pairs are
-          // all of its own bin has one class, so acc takes the same terms in the same order as without classes.
-          std::array<PairSums<D>, Binned && !Rebin ? kBinCount : 1> by_bin;
-          std::uint32_t bins_used = 0;
-          const auto sums_of = [&](int b) -> PairSums<D>& {
-            if (!Binned || Rebin || !due) return acc;
+          // A due particle's pairs by their bin b_ij (binned loop), each class weighted 2^-b_ij; acc is then their sum
+          // in class order, and the full-weight rates (full_a) sum them at 2^b_ij. The class of i's own bin, which holds
+          // nearly every pair, is summed in acc itself and the finer classes in by_bin: the same terms in the same order
+          // as one array of classes, so the same bits. by_bin's classes are constructed when first used: zeroing all
+          // kBinCount of them at every evaluation was part of what the binned loop cost over the single-rate one
+          // (docs/PERFORMANCE.md, "The binned loop's own cost").
+          ClassSums<Binned && !Rebin ? kBinCount : 1> by_bin;
+          std::uint32_t bins_used = 0;  // the classes finer than i's own bin that hold a pair
+          bool own_used = false;        // whether i's own class holds a pair
+          const auto finer_sums = [&](int b) -> PairSums<D>& {
             const auto k = static_cast<std::size_t>(b);
             if (!(bins_used & (1u << b))) {
-              by_bin[k] = PairSums<D>{};
+              ::new (static_cast<void*>(&by_bin.c[k])) PairSums<D>{};
               bins_used |= 1u << b;
             }
-            return by_bin[k];
+            return by_bin.c[k];
           };
           PairSums<D> full;  // with act.rebin: the sums at full weight
           double mu_max = 0.0;
@@ -236,10 +242,10 @@ class PairSweep {
               if (s.kind[j] == Kind::wall) {  // due, and within the wall effects' reach
                 ++pairs;
                 if constexpr (has_wall_effects) {
-                  if constexpr (!Rebin) {
+                  if constexpr (!Rebin) {  // a wall pair is in i's own class
                     pr.weight = Binned ? kBinWeight[static_cast<std::size_t>(bi)] : 1.0;
-                    PairSums<D>& into = sums_of(bi);
-                    std::apply([&](const auto&... eff) { (eff(s, pr, into), ...); }, wall_);
+                    own_used = true;
+                    std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, wall_);
                   } else {
                     PairSums<D> one;
                     pr.weight = 1.0;
@@ -270,8 +276,13 @@ class PairSweep {
                 // 2^-b_ij scales every fluid pair term (each is linear in grad W); a power of two, so exact.
                 pr.weight = kBinWeight[static_cast<std::size_t>(bij)];
                 pr.gradW = (pr.weight * factor) * xij;
-                PairSums<D>& into = sums_of(bij);
-                std::apply([&](const auto&... eff) { (eff(s, pr, into), ...); }, fluid_);
+                if (bij == bi || !due) {  // i's own class, or a particle that is not due (its kick alone)
+                  own_used = true;
+                  std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, fluid_);
+                } else {
+                  PairSums<D>& into = finer_sums(bij);
+                  std::apply([&](const auto&... eff) { (eff(s, pr, into), ...); }, fluid_);
+                }
               } else {  // the pair once at weight 1, then at this step's and at the next step's weight
                 const int nbj = act.bin(s.next_bin[j]);
                 PairSums<D> one;
@@ -292,11 +303,15 @@ class PairSweep {
             s.kick_rho[i] = acc.drho;
             return lim;
           }
-          if constexpr (Binned && !Rebin) {  // acc and full from the classes (bins_used: the one class, or several)
-            bool first = true;
-            for (int b = bi; b < kBinCount; ++b) {
-              if (!(bins_used & (1u << b))) continue;
-              const PairSums<D>& c = by_bin[static_cast<std::size_t>(b)];
+          if constexpr (Binned && !Rebin) {  // acc and full from the classes: i's own (in acc), then the finer ones
+            bool first = !own_used;
+            if (own_used) {
+              full.a = kBinScale[static_cast<std::size_t>(bi)] * acc.a;
+              full.drho = kBinScale[static_cast<std::size_t>(bi)] * acc.drho;
+            }
+            for (std::uint32_t used = bins_used; used != 0; used &= used - 1) {  // the finer classes, coarsest first
+              const int b = std::countr_zero(used);
+              const PairSums<D>& c = by_bin.c[static_cast<std::size_t>(b)];
               if (first) {
                 acc = c;
                 full.a = kBinScale[static_cast<std::size_t>(b)] * c.a;
@@ -356,6 +371,14 @@ class PairSweep {
         },
         [](const SweepLimits& x, const SweepLimits& y) { return x.merged(y); });
   }
+
+  /// Storage for N classes of pair sums, constructed one at a time as the classes are first used.
+  template <int N>
+  union ClassSums {
+    ClassSums() {}
+    PairSums<D> c[N];
+  };
+  static_assert(std::is_trivially_destructible_v<PairSums<D>>, "ClassSums never destroys its classes");
 
   /// sum += 2^-b one: a power of two, so the scaling is exact.
   static void add_weighted(PairSums<D>& sum, const PairSums<D>& one, int b) {
