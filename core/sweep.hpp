@@ -27,6 +27,7 @@
 #include "core/effects/pair.hpp"
 #include "core/kernel.hpp"
 #include "core/particle_store.hpp"
+#include "core/sweep_probe.hpp"
 #include "parallel/parallel_for.hpp"
 
 namespace sph {
@@ -149,225 +150,240 @@ class PairSweep {
     constexpr bool has_wall_effects = std::tuple_size_v<WallEffects> > 0;
     const double inf = std::numeric_limits<double>::infinity();
     SweepLimits init;
+    // One particle's sums, rates and limits.
+    const auto particle = [&](std::size_t i) SPH_ALWAYS_INLINE {
+      SweepLimits lim;
+      if (s.kind[i] != Kind::fluid || is_passive(s.role[i])) {
+        s.a[i].setZero();
+        s.drho[i] = 0.0;
+        s.kick[i].setZero();
+        s.kick_rho[i] = 0.0;
+        // A passive particle has no limit of its own: its bin is its level's (Integrator::bin_for with no limit),
+        // and it sets neither the coarse step nor a neighbour's bin. (Ghosts keep the limit copied from their
+        // source, which the neighbourhood bins read.)
+        if (s.kind[i] == Kind::fluid) {
+          s.dt_limit[i] = 0.0;
+          s.stiffness[i] = 1.0;
+        }
+        return lim;
+      }
+      const int bi = Binned ? act.bin(s.bin[i]) : 0;
+      const int nbi = Rebin ? act.bin(s.next_bin[i]) : bi;
+      const bool due = !Binned || bi >= act.active_bin;
+      PairSums<D> acc;
+      PairSums<D> next;  // with act.rebin: the sums weighted by the next bins
+      // A due particle's pairs by their bin b_ij (binned loop), each class weighted 2^-b_ij; acc is then their sum
+      // in class order, and the full-weight rates (full_a) sum them at 2^b_ij. The class of i's own bin, which holds
+      // nearly every pair, is summed in acc itself and the finer classes in by_bin: the same terms in the same order
+      // as one array of classes, so the same bits. by_bin's classes are constructed when first used: zeroing all
+      // kBinCount of them at every evaluation was part of what the binned loop cost over the single-rate one
+      // (docs/PERFORMANCE.md, "The binned loop's own cost").
+      ClassSums<Binned && !Rebin ? kBinCount : 1> by_bin;
+      std::uint32_t bins_used = 0;  // the classes finer than i's own bin that hold a pair
+      bool own_used = false;        // whether i's own class holds a pair
+      const auto finer_sums = [&](int b) -> PairSums<D>& {
+        const auto k = static_cast<std::size_t>(b);
+        if (!(bins_used & (1u << b))) {
+          ::new (static_cast<void*>(&by_bin.c[k])) PairSums<D>{};
+          bins_used |= 1u << b;
+        }
+        return by_bin.c[k];
+      };
+      PairSums<D> full;  // with act.rebin: the sums at full weight
+      double mu_max = 0.0;
+      double grad_mass = 0.0;  // sum_j m_j |grad W_ij| over the fluid and ghost pairs: the acoustic stiffness
+      std::size_t pairs = 0, candidates = 0;
+      Pair<D> pr;
+      pr.i = i;
+      const Vec<D> xi = s.x[i];
+      const Vec<D> vi = s.v[i];
+      const double hi = s.h[i];
+      const double inv_hi = 1.0 / hi;
+      pr.p_rho2_i = s.p[i] / (s.rho[i] * s.rho[i]);
+      // Wall particles act only within the wall effects' reach (Lennard-Jones: r0 = r0_factor d_i, well inside
+      // the support h_i), so those beyond it are skipped before the pair's geometry is computed. The bound is
+      // widened by a relative 1e-12 so that every pair the effect's own test (r < r0) keeps passes it: the
+      // results do not change, only the work.
+      double wall_reach2 = 0.0;
+      if constexpr (has_wall_effects) {
+        double reach = 0.0;
+        std::apply([&](const auto&... eff) { ((reach = std::max(reach, eff.reach(s, i))), ...); }, wall_);
+        reach *= 1.0 + 1e-12;
+        wall_reach2 = reach * reach;
+      }
+      // A particle that is not due only meets due ones: it skips a layer (a level) or a run without any.
+      const bool all = !Binned || due || act.due_prefix == nullptr;
+      const auto holds_due = [&](std::uint32_t b, std::uint32_t e) { return all || act.due_prefix[e] != act.due_prefix[b]; };
+      // Only the due candidates of a run when i is not due and their list is there: a pair with i is due only
+      // when j is (b_ij = b_j >= active bin), and walls pair only with due particles.
+      const bool due_only = Binned && !all && act.due_index != nullptr;
+      grid.for_each_support_run(xi, hi, [&](std::uint32_t b, std::uint32_t e) SPH_ALWAYS_INLINE {
+        if (!holds_due(b, e)) return;
+        const std::uint32_t first = due_only ? act.due_prefix[b] : b;
+        const std::uint32_t last = due_only ? act.due_prefix[e] : e;
+        candidates += last - first;
+        for (std::uint32_t q = first; q < last; ++q) {
+          const std::uint32_t j = due_only ? act.due_index[q] : q;
+          const Vec<D> xij = xi - s.x[j];
+          const double r2 = xij.squaredNorm();
+          const double support = hi + s.h[j];
+          if (r2 >= support * support || j == i) continue;
+          if constexpr (OwnLevel) {
+            if (s.kind[j] != Kind::wall && s.level[j] != s.level[i]) continue;
+          }
+          if (s.kind[j] == Kind::wall && !((!Binned || due) && r2 < wall_reach2)) continue;
+          pr.j = j;
+          pr.xij = xij;
+          pr.r2 = r2;
+          pr.r = std::sqrt(r2);
+          pr.hij = 0.5 * support;
+          pr.vij = vi - s.v[j];
+          pr.vx = pr.vij.dot(xij);
+          if (s.kind[j] == Kind::wall) {  // due, and within the wall effects' reach
+            ++pairs;
+            if constexpr (has_wall_effects) {
+              if constexpr (!Rebin) {  // a wall pair is in i's own class
+                pr.weight = Binned ? kBinWeight[static_cast<std::size_t>(bi)] : 1.0;
+                own_used = true;
+                std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, wall_);
+              } else {
+                PairSums<D> one;
+                pr.weight = 1.0;
+                std::apply([&](const auto&... eff) { (eff(s, pr, one), ...); }, wall_);
+                add_weighted(acc, one, bi);
+                add_weighted(next, one, nbi);
+                add_weighted(full, one, 0);
+              }
+            }
+            continue;
+          }
+          int bij = 0;
+          if constexpr (Binned) {
+            const int bj = act.bin(s.bin[j]);
+            bij = bi > bj ? bi : bj;
+            if (bij < act.active_bin) continue;
+          }
+          ++pairs;
+          const double inv_hij = s.h[j] == hi ? inv_hi : 1.0 / pr.hij;
+          const double factor = Kernel::gradient_factor_inv(pr.r, inv_hij);
+          grad_mass += s.m[j] * std::abs(factor) * pr.r;
+          pr.mu = pr.hij * pr.vx / (r2 + 0.01 * pr.hij * pr.hij);
+          if constexpr (!Binned) {
+            pr.weight = 1.0;
+            pr.gradW = factor * xij;
+            std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, fluid_);
+          } else if constexpr (!Rebin) {
+            // 2^-b_ij scales every fluid pair term (each is linear in grad W); a power of two, so exact.
+            pr.weight = kBinWeight[static_cast<std::size_t>(bij)];
+            pr.gradW = (pr.weight * factor) * xij;
+            if (bij == bi || !due) {  // i's own class, or a particle that is not due (its kick alone)
+              own_used = true;
+              std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, fluid_);
+            } else {
+              PairSums<D>& into = finer_sums(bij);
+              std::apply([&](const auto&... eff) { (eff(s, pr, into), ...); }, fluid_);
+            }
+          } else {  // the pair once at weight 1, then at this step's and at the next step's weight
+            const int nbj = act.bin(s.next_bin[j]);
+            PairSums<D> one;
+            pr.weight = 1.0;
+            pr.gradW = factor * xij;
+            std::apply([&](const auto&... eff) { (eff(s, pr, one), ...); }, fluid_);
+            add_weighted(acc, one, bij);
+            add_weighted(next, one, nbi > nbj ? nbi : nbj);
+            add_weighted(full, one, 0);
+          }
+          mu_max = std::max(mu_max, std::abs(pr.mu));
+        }
+      }, holds_due);
+      lim.pairs = pairs;
+      lim.candidates = candidates;
+      if (!due) {  // only the pairs with a due partner: their impulses, no rates, no limits
+        s.kick[i] = acc.a;
+        s.kick_rho[i] = acc.drho;
+        return lim;
+      }
+      if constexpr (Binned && !Rebin) {  // acc and full from the classes: i's own (in acc), then the finer ones
+        bool first = !own_used;
+        if (own_used) {
+          full.a = kBinScale[static_cast<std::size_t>(bi)] * acc.a;
+          full.drho = kBinScale[static_cast<std::size_t>(bi)] * acc.drho;
+        }
+        for (std::uint32_t used = bins_used; used != 0; used &= used - 1) {  // the finer classes, coarsest first
+          const int b = std::countr_zero(used);
+          const PairSums<D>& c = by_bin.c[static_cast<std::size_t>(b)];
+          if (first) {
+            acc = c;
+            full.a = kBinScale[static_cast<std::size_t>(b)] * c.a;
+            full.drho = kBinScale[static_cast<std::size_t>(b)] * c.drho;
+            first = false;
+          } else {
+            acc.a += c.a;
+            acc.drho += c.drho;
+            full.a += kBinScale[static_cast<std::size_t>(b)] * c.a;
+            full.drho += kBinScale[static_cast<std::size_t>(b)] * c.drho;
+          }
+        }
+      }
+      acc.a += kBinWeight[static_cast<std::size_t>(bi)] * gravity_;
+      s.kick[i] = acc.a;
+      s.kick_rho[i] = acc.drho;
+      // The rates and limits are those of the bin the particle opens its next step in.
+      const double scale = kBinScale[static_cast<std::size_t>(nbi)];
+      if constexpr (Rebin) {
+        next.a += kBinWeight[static_cast<std::size_t>(nbi)] * gravity_;
+      } else {
+        next = acc;
+      }
+      {
+        const Vec<D> a_new = scale * next.a;
+        const double drho_new = scale * next.drho;
+        // The rates at full weight: a and drho themselves where every pair is of i's own bin (bitwise: the classes'
+        // scalings are powers of two), the single-rate loop included.
+        Vec<D> full_a_new = a_new;
+        double full_drho_new = drho_new;
+        if constexpr (Binned) {
+          full_a_new = full.a + gravity_;
+          full_drho_new = full.drho;
+        }
+        if (act.dt0 > 0.0) {  // the rates' change since i's last evaluation, dt0 2^-b_i ago (Integrator::drift)
+          const double since = act.dt0 * kBinWeight[static_cast<std::size_t>(bi)];
+          s.jerk[i] = (full_a_new - s.full_a[i]) / since;
+          s.density_jerk[i] = (full_drho_new - s.full_drho[i]) / since;
+        }
+        s.a[i] = a_new;
+        s.drho[i] = drho_new;
+        s.full_a[i] = full_a_new;
+        s.full_drho[i] = full_drho_new;
+      }
+      const double an = s.a[i].norm();
+      const double own_force = an > 0.0 ? std::sqrt(hi / an) : inf;
+      // h_i / (c0 + max mu), with h_i shortened where the neighbours are stiffer than i's own lattice
+      // (LatticeGradientSum::acoustic_length; docs/METHOD.md, "Time step and three refinement levels").
+      const double length = acoustic_.length(lattice_, hi, s.d[i], s.rho[i], grad_mass);
+      const double own_cfl = length / (c0_ + mu_max);
+      s.stiffness[i] = hi / length;
+      s.dt_limit[i] = std::min(own_force, own_cfl);
+      lim.dt_force = scale * own_force;
+      lim.dt_cfl = scale * own_cfl;
+      lim.finest_bin = nbi;
+      return lim;
+    };
     return par::reduce(
         s.n, init,
         [&](std::size_t i) {
-          SweepLimits lim;
-          if (s.kind[i] != Kind::fluid || is_passive(s.role[i])) {
-            s.a[i].setZero();
-            s.drho[i] = 0.0;
-            s.kick[i].setZero();
-            s.kick_rho[i] = 0.0;
-            // A passive particle has no limit of its own: its bin is its level's (Integrator::bin_for with no limit),
-            // and it sets neither the coarse step nor a neighbour's bin. (Ghosts keep the limit copied from their
-            // source, which the neighbourhood bins read.)
-            if (s.kind[i] == Kind::fluid) {
-              s.dt_limit[i] = 0.0;
-              s.stiffness[i] = 1.0;
-            }
+          if constexpr (!probe::kEnabled) {
+            return particle(i);
+          } else {  // the instrument of core/sweep_probe.hpp
+            const std::uint64_t start = probe::now();
+            const SweepLimits lim = particle(i);
+            const std::uint64_t cycles = probe::now() - start;
+            const bool fluid = s.kind[i] == Kind::fluid && !is_passive(s.role[i]);
+            const bool due = !Binned || act.bin(s.bin[i]) >= act.active_bin;
+            probe::record(Rebin ? probe::Loop::rebin : Binned ? probe::Loop::binned : probe::Loop::single, fluid, due,
+                          s.level[i], cycles, lim.pairs, lim.candidates);
             return lim;
           }
-          const int bi = Binned ? act.bin(s.bin[i]) : 0;
-          const int nbi = Rebin ? act.bin(s.next_bin[i]) : bi;
-          const bool due = !Binned || bi >= act.active_bin;
-          PairSums<D> acc;
-          PairSums<D> next;  // with act.rebin: the sums weighted by the next bins
-          // A due particle's pairs by their bin b_ij (binned loop), each class weighted 2^-b_ij; acc is then their sum
-          // in class order, and the full-weight rates (full_a) sum them at 2^b_ij. The class of i's own bin, which holds
-          // nearly every pair, is summed in acc itself and the finer classes in by_bin: the same terms in the same order
-          // as one array of classes, so the same bits. by_bin's classes are constructed when first used: zeroing all
-          // kBinCount of them at every evaluation was part of what the binned loop cost over the single-rate one
-          // (docs/PERFORMANCE.md, "The binned loop's own cost").
-          ClassSums<Binned && !Rebin ? kBinCount : 1> by_bin;
-          std::uint32_t bins_used = 0;  // the classes finer than i's own bin that hold a pair
-          bool own_used = false;        // whether i's own class holds a pair
-          const auto finer_sums = [&](int b) -> PairSums<D>& {
-            const auto k = static_cast<std::size_t>(b);
-            if (!(bins_used & (1u << b))) {
-              ::new (static_cast<void*>(&by_bin.c[k])) PairSums<D>{};
-              bins_used |= 1u << b;
-            }
-            return by_bin.c[k];
-          };
-          PairSums<D> full;  // with act.rebin: the sums at full weight
-          double mu_max = 0.0;
-          double grad_mass = 0.0;  // sum_j m_j |grad W_ij| over the fluid and ghost pairs: the acoustic stiffness
-          std::size_t pairs = 0, candidates = 0;
-          Pair<D> pr;
-          pr.i = i;
-          const Vec<D> xi = s.x[i];
-          const Vec<D> vi = s.v[i];
-          const double hi = s.h[i];
-          const double inv_hi = 1.0 / hi;
-          pr.p_rho2_i = s.p[i] / (s.rho[i] * s.rho[i]);
-          // Wall particles act only within the wall effects' reach (Lennard-Jones: r0 = r0_factor d_i, well inside
-          // the support h_i), so those beyond it are skipped before the pair's geometry is computed. The bound is
-          // widened by a relative 1e-12 so that every pair the effect's own test (r < r0) keeps passes it: the
-          // results do not change, only the work.
-          double wall_reach2 = 0.0;
-          if constexpr (has_wall_effects) {
-            double reach = 0.0;
-            std::apply([&](const auto&... eff) { ((reach = std::max(reach, eff.reach(s, i))), ...); }, wall_);
-            reach *= 1.0 + 1e-12;
-            wall_reach2 = reach * reach;
-          }
-          // A particle that is not due only meets due ones: it skips a layer (a level) or a run without any.
-          const bool all = !Binned || due || act.due_prefix == nullptr;
-          const auto holds_due = [&](std::uint32_t b, std::uint32_t e) { return all || act.due_prefix[e] != act.due_prefix[b]; };
-          // Only the due candidates of a run when i is not due and their list is there: a pair with i is due only
-          // when j is (b_ij = b_j >= active bin), and walls pair only with due particles.
-          const bool due_only = Binned && !all && act.due_index != nullptr;
-          grid.for_each_support_run(xi, hi, [&](std::uint32_t b, std::uint32_t e) SPH_ALWAYS_INLINE {
-            if (!holds_due(b, e)) return;
-            const std::uint32_t first = due_only ? act.due_prefix[b] : b;
-            const std::uint32_t last = due_only ? act.due_prefix[e] : e;
-            candidates += last - first;
-            for (std::uint32_t q = first; q < last; ++q) {
-              const std::uint32_t j = due_only ? act.due_index[q] : q;
-              const Vec<D> xij = xi - s.x[j];
-              const double r2 = xij.squaredNorm();
-              const double support = hi + s.h[j];
-              if (r2 >= support * support || j == i) continue;
-              if constexpr (OwnLevel) {
-                if (s.kind[j] != Kind::wall && s.level[j] != s.level[i]) continue;
-              }
-              if (s.kind[j] == Kind::wall && !((!Binned || due) && r2 < wall_reach2)) continue;
-              pr.j = j;
-              pr.xij = xij;
-              pr.r2 = r2;
-              pr.r = std::sqrt(r2);
-              pr.hij = 0.5 * support;
-              pr.vij = vi - s.v[j];
-              pr.vx = pr.vij.dot(xij);
-              if (s.kind[j] == Kind::wall) {  // due, and within the wall effects' reach
-                ++pairs;
-                if constexpr (has_wall_effects) {
-                  if constexpr (!Rebin) {  // a wall pair is in i's own class
-                    pr.weight = Binned ? kBinWeight[static_cast<std::size_t>(bi)] : 1.0;
-                    own_used = true;
-                    std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, wall_);
-                  } else {
-                    PairSums<D> one;
-                    pr.weight = 1.0;
-                    std::apply([&](const auto&... eff) { (eff(s, pr, one), ...); }, wall_);
-                    add_weighted(acc, one, bi);
-                    add_weighted(next, one, nbi);
-                    add_weighted(full, one, 0);
-                  }
-                }
-                continue;
-              }
-              int bij = 0;
-              if constexpr (Binned) {
-                const int bj = act.bin(s.bin[j]);
-                bij = bi > bj ? bi : bj;
-                if (bij < act.active_bin) continue;
-              }
-              ++pairs;
-              const double inv_hij = s.h[j] == hi ? inv_hi : 1.0 / pr.hij;
-              const double factor = Kernel::gradient_factor_inv(pr.r, inv_hij);
-              grad_mass += s.m[j] * std::abs(factor) * pr.r;
-              pr.mu = pr.hij * pr.vx / (r2 + 0.01 * pr.hij * pr.hij);
-              if constexpr (!Binned) {
-                pr.weight = 1.0;
-                pr.gradW = factor * xij;
-                std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, fluid_);
-              } else if constexpr (!Rebin) {
-                // 2^-b_ij scales every fluid pair term (each is linear in grad W); a power of two, so exact.
-                pr.weight = kBinWeight[static_cast<std::size_t>(bij)];
-                pr.gradW = (pr.weight * factor) * xij;
-                if (bij == bi || !due) {  // i's own class, or a particle that is not due (its kick alone)
-                  own_used = true;
-                  std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, fluid_);
-                } else {
-                  PairSums<D>& into = finer_sums(bij);
-                  std::apply([&](const auto&... eff) { (eff(s, pr, into), ...); }, fluid_);
-                }
-              } else {  // the pair once at weight 1, then at this step's and at the next step's weight
-                const int nbj = act.bin(s.next_bin[j]);
-                PairSums<D> one;
-                pr.weight = 1.0;
-                pr.gradW = factor * xij;
-                std::apply([&](const auto&... eff) { (eff(s, pr, one), ...); }, fluid_);
-                add_weighted(acc, one, bij);
-                add_weighted(next, one, nbi > nbj ? nbi : nbj);
-                add_weighted(full, one, 0);
-              }
-              mu_max = std::max(mu_max, std::abs(pr.mu));
-            }
-          }, holds_due);
-          lim.pairs = pairs;
-          lim.candidates = candidates;
-          if (!due) {  // only the pairs with a due partner: their impulses, no rates, no limits
-            s.kick[i] = acc.a;
-            s.kick_rho[i] = acc.drho;
-            return lim;
-          }
-          if constexpr (Binned && !Rebin) {  // acc and full from the classes: i's own (in acc), then the finer ones
-            bool first = !own_used;
-            if (own_used) {
-              full.a = kBinScale[static_cast<std::size_t>(bi)] * acc.a;
-              full.drho = kBinScale[static_cast<std::size_t>(bi)] * acc.drho;
-            }
-            for (std::uint32_t used = bins_used; used != 0; used &= used - 1) {  // the finer classes, coarsest first
-              const int b = std::countr_zero(used);
-              const PairSums<D>& c = by_bin.c[static_cast<std::size_t>(b)];
-              if (first) {
-                acc = c;
-                full.a = kBinScale[static_cast<std::size_t>(b)] * c.a;
-                full.drho = kBinScale[static_cast<std::size_t>(b)] * c.drho;
-                first = false;
-              } else {
-                acc.a += c.a;
-                acc.drho += c.drho;
-                full.a += kBinScale[static_cast<std::size_t>(b)] * c.a;
-                full.drho += kBinScale[static_cast<std::size_t>(b)] * c.drho;
-              }
-            }
-          }
-          acc.a += kBinWeight[static_cast<std::size_t>(bi)] * gravity_;
-          s.kick[i] = acc.a;
-          s.kick_rho[i] = acc.drho;
-          // The rates and limits are those of the bin the particle opens its next step in.
-          const double scale = kBinScale[static_cast<std::size_t>(nbi)];
-          if constexpr (Rebin) {
-            next.a += kBinWeight[static_cast<std::size_t>(nbi)] * gravity_;
-          } else {
-            next = acc;
-          }
-          {
-            const Vec<D> a_new = scale * next.a;
-            const double drho_new = scale * next.drho;
-            // The rates at full weight: a and drho themselves where every pair is of i's own bin (bitwise: the classes'
-            // scalings are powers of two), the single-rate loop included.
-            Vec<D> full_a_new = a_new;
-            double full_drho_new = drho_new;
-            if constexpr (Binned) {
-              full_a_new = full.a + gravity_;
-              full_drho_new = full.drho;
-            }
-            if (act.dt0 > 0.0) {  // the rates' change since i's last evaluation, dt0 2^-b_i ago (Integrator::drift)
-              const double since = act.dt0 * kBinWeight[static_cast<std::size_t>(bi)];
-              s.jerk[i] = (full_a_new - s.full_a[i]) / since;
-              s.density_jerk[i] = (full_drho_new - s.full_drho[i]) / since;
-            }
-            s.a[i] = a_new;
-            s.drho[i] = drho_new;
-            s.full_a[i] = full_a_new;
-            s.full_drho[i] = full_drho_new;
-          }
-          const double an = s.a[i].norm();
-          const double own_force = an > 0.0 ? std::sqrt(hi / an) : inf;
-          // h_i / (c0 + max mu), with h_i shortened where the neighbours are stiffer than i's own lattice
-          // (LatticeGradientSum::acoustic_length; docs/METHOD.md, "Time step and three refinement levels").
-          const double length = acoustic_.length(lattice_, hi, s.d[i], s.rho[i], grad_mass);
-          const double own_cfl = length / (c0_ + mu_max);
-          s.stiffness[i] = hi / length;
-          s.dt_limit[i] = std::min(own_force, own_cfl);
-          lim.dt_force = scale * own_force;
-          lim.dt_cfl = scale * own_cfl;
-          lim.finest_bin = nbi;
-          return lim;
         },
         [](const SweepLimits& x, const SweepLimits& y) { return x.merged(y); });
   }
