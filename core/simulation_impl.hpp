@@ -388,8 +388,13 @@ template <int D>
 Activity SimulationT<D>::activity(int k, int finest) {
   Activity act = integrator_.activity(k, finest);
   act.own_level_only = buffered();
-  if (act.active_bin == 0) return act;  // every particle is due
   const auto s = store_.view();
+  if (act.bin_cap > 0) {  // the finest bin in the store: fluid (active or passive), ghosts and halos, as they pair
+    act.top_bin = par::reduce(
+        s.n, 0, [&](std::size_t i) { return s.kind[i] == Kind::wall ? 0 : act.bin(s.bin[i]); },
+        [](int a, int b) { return a > b ? a : b; });
+  }
+  if (act.active_bin == 0) return act;  // every particle is due
   due_prefix_.resize(s.n + 1);
   par::parallel_for(s.n, [&](std::size_t i) {
     due_prefix_[i] = s.kind[i] != Kind::wall && act.bin(s.bin[i]) >= act.active_bin ? 1u : 0u;

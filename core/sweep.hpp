@@ -82,6 +82,10 @@ struct Activity {
   // Buffered levels (LevelCoupling::buffered, core/refinement/buffer.hpp): a fluid particle pairs only with fluid and
   // ghosts of its own level, and a passive particle gets no sums (as a wall); wall particles pair as always.
   bool own_level_only = false;
+  // The finest bin (bin(), capped) of any particle in the store but the walls, so of any particle a fluid particle
+  // pairs with by bins: a due particle in it pairs at its own bin with all of them, and the binned loop walks its
+  // pairs without reading their bins. kBinCount where unknown: no particle is in it.
+  int top_bin = kBinCount;
   int bin(std::int32_t b) const { return b < bin_cap ? static_cast<int>(b) : bin_cap; }
 };
 
@@ -170,6 +174,7 @@ class PairSweep {
       const int bi = Binned ? act.bin(s.bin[i]) : 0;
       const int nbi = Rebin ? act.bin(s.next_bin[i]) : bi;
       const bool due = !Binned || bi >= act.active_bin;
+      const bool top = Binned && !Rebin && due && bi >= act.top_bin;  // every pair in i's own bin (Activity::top_bin)
       PairSums<D> acc;
       PairSums<D> next;  // with act.rebin: the sums weighted by the next bins
       // A due particle's pairs by their bin b_ij (binned loop), each class weighted 2^-b_ij; acc is then their sum
@@ -217,7 +222,9 @@ class PairSweep {
       // Only the due candidates of a run when i is not due and their list is there: a pair with i is due only
       // when j is (b_ij = b_j >= active bin), and walls pair only with due particles.
       const bool due_only = Binned && !all && act.due_index != nullptr;
-      grid.for_each_support_run(xi, hi, [&](std::uint32_t b, std::uint32_t e) SPH_ALWAYS_INLINE {
+      // The candidate runs, walked by one of two loops: for a particle in the top bin, b_ij = b_i without a look-up.
+      const auto walk = [&](auto top_tag, std::uint32_t b, std::uint32_t e) SPH_ALWAYS_INLINE {
+        constexpr bool Top = decltype(top_tag)::value;
         if (!holds_due(b, e)) return;
         const std::uint32_t first = due_only ? act.due_prefix[b] : b;
         const std::uint32_t last = due_only ? act.due_prefix[e] : e;
@@ -258,7 +265,9 @@ class PairSweep {
             continue;
           }
           int bij = 0;
-          if constexpr (Binned) {
+          if constexpr (Top) {
+            bij = bi;
+          } else if constexpr (Binned) {
             const int bj = act.bin(s.bin[j]);
             bij = bi > bj ? bi : bj;
             if (bij < act.active_bin) continue;
@@ -276,7 +285,7 @@ class PairSweep {
             // 2^-b_ij scales every fluid pair term (each is linear in grad W); a power of two, so exact.
             pr.weight = kBinWeight[static_cast<std::size_t>(bij)];
             pr.gradW = (pr.weight * factor) * xij;
-            if (bij == bi || !due) {  // i's own class, or a particle that is not due (its kick alone)
+            if (Top || bij == bi || !due) {  // i's own class, or a particle that is not due (its kick alone)
               own_used = true;
               std::apply([&](const auto&... eff) { (eff(s, pr, acc), ...); }, fluid_);
             } else {
@@ -295,7 +304,16 @@ class PairSweep {
           }
           mu_max = std::max(mu_max, std::abs(pr.mu));
         }
-      }, holds_due);
+      };
+      if (top) {
+        grid.for_each_support_run(
+            xi, hi, [&](std::uint32_t b, std::uint32_t e) SPH_ALWAYS_INLINE { walk(std::true_type{}, b, e); },
+            holds_due);
+      } else {
+        grid.for_each_support_run(
+            xi, hi, [&](std::uint32_t b, std::uint32_t e) SPH_ALWAYS_INLINE { walk(std::false_type{}, b, e); },
+            holds_due);
+      }
       lim.pairs = pairs;
       lim.candidates = candidates;
       if (!due) {  // only the pairs with a due partner: their impulses, no rates, no limits

@@ -51,17 +51,20 @@ TEST(Sweep, TimeBinsEqualBruteForce) {
       build_grid(s, grid);
     }
     for (const int active : {2, 1, 0}) {
-      // The kicks and candidates of each variant: none, the prefix, the prefix and the due list.
-      std::vector<std::vector<Vec<2>>> kicks;
+      // The kicks, rates and candidates of each variant: none, the prefix, the prefix and the due list, and those
+      // with the top bin (Activity::top_bin: the level-2 particles walk their pairs without reading their bins).
+      std::vector<std::vector<Vec<2>>> kicks, rates;
       std::vector<std::uint64_t> candidates;
-      for (const int skip : {0, 1, 2}) {
+      for (const int skip : {0, 1, 2, 3}) {
         SCOPED_TRACE(testing::Message() << "active bin " << active
-                                        << (skip == 1 ? ", with the prefix" : (skip == 2 ? ", with the due list" : ""))
+                                        << (skip == 1 ? ", with the prefix" : (skip >= 2 ? ", with the due list" : ""))
+                                        << (skip == 3 ? " and the top bin" : "")
                                         << (layered ? ", a layer per level" : ", one grid"));
         sph::Activity act{active, sph::Integrator::kMaxBin};
         const DueLists due = due_lists(s, act);
         if (skip >= 1) act.due_prefix = due.prefix.data();
-        if (skip == 2) act.due_index = due.index.data();
+        if (skip >= 2) act.due_index = due.index.data();
+        if (skip == 3) act.top_bin = 2;
         const Vec<2> sentinel(1234.5, -6789.0);
         for (std::size_t i = 0; i < s.size(); ++i) {
           s.a[i] = sentinel;
@@ -83,12 +86,17 @@ TEST(Sweep, TimeBinsEqualBruteForce) {
           EXPECT_EQ(lim.finest_bin, 2);
         }
         kicks.emplace_back(s.kick.values().begin(), s.kick.values().end());
+        rates.emplace_back(s.full_a.values().begin(), s.full_a.values().end());
         candidates.push_back(lim.candidates);
       }
-      // The prefix and the due list only skip candidates that cannot pair: the same sums, bit for bit, in the same
-      // order; with some particles not due, each skips some.
+      // The prefix and the due list only skip candidates that cannot pair, and the top bin only skips reading bins
+      // that cannot change b_ij: the same sums, bit for bit, in the same order; with some particles not due, the
+      // prefix and the list each skip some candidates.
       EXPECT_EQ(kicks[1], kicks[0]);
       EXPECT_EQ(kicks[2], kicks[0]);
+      EXPECT_EQ(kicks[3], kicks[0]);
+      EXPECT_EQ(rates[3], rates[0]);
+      EXPECT_EQ(candidates[3], candidates[2]);
       if (active > 0) {
         EXPECT_LE(candidates[1], candidates[0]);
         // With a layer per level every particle of a due layer is due here (each level in its own bin): the list
