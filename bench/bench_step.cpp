@@ -47,8 +47,9 @@ void BM_Step_DamBreak(benchmark::State& state, bool ghosts) {
 void BM_Step_WithGhosts(benchmark::State& state) { BM_Step_DamBreak(state, true); }
 void BM_Step_WithoutGhosts(benchmark::State& state) { BM_Step_DamBreak(state, false); }
 
-// The sweep alone on a prepared store, for each effect set.
-void BM_Sweep_Effects(benchmark::State& state, bool viscosity, bool lennard_jones) {
+// The sweep alone on a prepared store, for each effect set, with the loop the activity selects (the single-rate one
+// by default).
+void BM_Sweep(benchmark::State& state, bool viscosity, bool lennard_jones, const Activity& act = {}) {
   omp_set_num_threads(static_cast<int>(state.range(1)));
   DamBreakSpec spec = block(static_cast<std::size_t>(state.range(0)));
   spec.viscosity = viscosity;
@@ -57,7 +58,7 @@ void BM_Sweep_Effects(benchmark::State& state, bool viscosity, bool lennard_jone
   for (int k = 0; k < 20; ++k) sim.step();  // a moving state, so that viscosity does work
   const auto sweep = make_sweep(sim.settings());
   const std::size_t fluid = sim.diagnostics().fluid;
-  for (auto _ : state) benchmark::DoNotOptimize(sweep->run(sim.store().view(), sim.grid()));
+  for (auto _ : state) benchmark::DoNotOptimize(sweep->run(sim.store().view(), sim.grid(), act));
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * fluid));
 }
 
@@ -66,42 +67,24 @@ void BM_Sweep_Effects(benchmark::State& state, bool viscosity, bool lennard_jone
 // store and effects (BM_Sweep_ViscosityAndLennardJones). Issue #16: what a per-level run's closing evaluations
 // cost per pair over a single-rate run's.
 void BM_Sweep_Rebin(benchmark::State& state) {
-  omp_set_num_threads(static_cast<int>(state.range(1)));
-  DamBreakSpec spec = block(static_cast<std::size_t>(state.range(0)));
-  spec.viscosity = true;
-  spec.lennard_jones = true;
-  Simulation sim = make_dam_break(spec);
-  for (int k = 0; k < 20; ++k) sim.step();
-  const auto sweep = make_sweep(sim.settings());
   Activity act;
   act.rebin = true;
-  const std::size_t fluid = sim.diagnostics().fluid;
-  for (auto _ : state) benchmark::DoNotOptimize(sweep->run(sim.store().view(), sim.grid(), act));
-  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * fluid));
+  BM_Sweep(state, true, true, act);
 }
 
 // The binned loop of a per-level run's inner evaluations (every particle due, in bin 0 of a store allowed two bins)
 // against the single-rate loop on the same store and effects (BM_Sweep_ViscosityAndLennardJones): what the binned
 // loop costs per pair on its own, with the same pairs and sums (issue #16).
 void BM_Sweep_Binned(benchmark::State& state) {
-  omp_set_num_threads(static_cast<int>(state.range(1)));
-  DamBreakSpec spec = block(static_cast<std::size_t>(state.range(0)));
-  spec.viscosity = true;
-  spec.lennard_jones = true;
-  Simulation sim = make_dam_break(spec);
-  for (int k = 0; k < 20; ++k) sim.step();
-  const auto sweep = make_sweep(sim.settings());
   Activity act;
   act.bin_cap = 1;
-  const std::size_t fluid = sim.diagnostics().fluid;
-  for (auto _ : state) benchmark::DoNotOptimize(sweep->run(sim.store().view(), sim.grid(), act));
-  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * fluid));
+  BM_Sweep(state, true, true, act);
 }
 
-void BM_Sweep_PressureOnly(benchmark::State& s) { BM_Sweep_Effects(s, false, false); }
-void BM_Sweep_Viscosity(benchmark::State& s) { BM_Sweep_Effects(s, true, false); }
-void BM_Sweep_LennardJones(benchmark::State& s) { BM_Sweep_Effects(s, false, true); }
-void BM_Sweep_ViscosityAndLennardJones(benchmark::State& s) { BM_Sweep_Effects(s, true, true); }
+void BM_Sweep_PressureOnly(benchmark::State& s) { BM_Sweep(s, false, false); }
+void BM_Sweep_Viscosity(benchmark::State& s) { BM_Sweep(s, true, false); }
+void BM_Sweep_LennardJones(benchmark::State& s) { BM_Sweep(s, false, true); }
+void BM_Sweep_ViscosityAndLennardJones(benchmark::State& s) { BM_Sweep(s, true, true); }
 
 // A still tank in 2D and 3D at N fluid particles (h = 1.2 d, ghost walls): the cost of a step per particle and per
 // pair interaction, for the dimensions' ratio (issue #18: at most 1.5x per pair) and for how the 3D step scales
