@@ -276,5 +276,16 @@ inline ParticleStore<2> twin_cloud(const SolverSettings& st, std::uint32_t seed)
   return s;
 }
 
+/// Every third fluid particle of the cloud passive (alternately a shadow and a buffer particle).
+template <int D>
+std::size_t make_some_passive(ParticleStore<D>& s) {
+  std::size_t passive = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s.kind[i] != Kind::fluid || i % 3 != 1) continue;
+    s.role[i] = (i / 3) % 2 == 0 ? Role::shadow : Role::buffer;
+    ++passive;
+  }
+  return passive;
+}
 
 }  // namespace sph::test
