@@ -39,6 +39,7 @@
 // evaluated at the finer rate, from both sides. Steps end with every bin synchronised, so refinement,
 // coarsening, output and checkpoints only ever see synchronised particles.
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstddef>
@@ -115,6 +116,25 @@ class Integrator {
     // this runs nine times per particle and step in Simulation::choose_bins).
     while (b < bin_cap() && dt0 * kBinWeight[static_cast<std::size_t>(b)] > allowed) ++b;
     return b;
+  }
+  /// bin_for at each of the kShrinks candidate steps target * shrink(k) (Simulation::choose_bins), each equal to
+  /// bin_for's. One walk, for k = 0; the others follow from it: the candidates fall with k and a bin's step
+  /// dt0 2^-b is exact, so the bins do not rise with k, and the last candidate, exactly half the first, is at
+  /// most one bin coarser (its test at bin b is the first's at b + 1). So bin k is the first's or one less, by one
+  /// comparison, the walk's own. (Nine walks per particle and step were 2 % of a per-level run.)
+  template <int D>
+  void bins_for_shares(const ParticleView<D>& s, std::size_t i, const std::array<double, kShrinks>& candidate,
+                       double cfl, std::array<int, kShrinks>& out) const {
+    static_assert(kShrinks >= 2);
+    const int start = bin(s.level[i]);
+    const double limit = s.dt_limit[i];
+    const int b0 = bin_from(start, candidate[0], cfl, limit);
+    out[0] = b0;
+    const double allowed = cfl * limit;
+    const double w = b0 > start ? kBinWeight[static_cast<std::size_t>(b0 - 1)] : 0.0;
+    for (std::size_t k = 1; k < kShrinks; ++k) {
+      out[k] = b0 > start && !(candidate[k] * w > allowed) ? b0 - 1 : b0;
+    }
   }
 
   /// neighbourhood_bins' workspace, reused from step to step.

@@ -261,8 +261,10 @@ bool SimulationT<D>::choose_bins(bool neighbourhoods) {
       s.n, Costs{},
       [&](Costs& c, std::size_t i) {
         if (s.kind[i] != Kind::fluid) return;
+        std::array<int, K> bins;
+        integ.bins_for_shares(s, i, candidate, cfl, bins);
         for (std::size_t k = 0; k < K; ++k) {
-          const int b = integ.bin_for(s, i, candidate[k], cfl);
+          const int b = bins[k];
           c[k] += std::uint64_t{1} << b;
           c[K + k] = std::max(c[K + k], static_cast<std::uint64_t>(b));
         }

@@ -5,6 +5,8 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
+#include <limits>
 #include <cmath>
 #include <random>
 #include <set>
@@ -419,6 +421,41 @@ TEST(Integrator, NeighbourhoodBinsEqualBruteForce) {
       EXPECT_GE(bins.size(), 2u);
     }
   }
+}
+
+// Integrator::bins_for_shares, the one walk behind Simulation::choose_bins' nine candidate steps, equals bin_for at
+// each candidate, exactly. Limits spread over three decades around the candidates' steps (so that each particle's
+// bin falls at its level, a few bins finer, or at the cap), on every level of the three-level cloud, and the edge
+// cases bin_from treats apart: no limit yet (0), a NaN limit and an infinite target.
+TEST(Integrator, BinsForSharesEqualBinForAtEachCandidate) {
+  ASSERT_EQ(Integrator::shrink(Integrator::kShrinks - 1), 0.5) << "the premise: the last candidate is half the first";
+  Simulation sim = three_level_cloud(TimeStepping::per_level);
+  ParticleStore<2> s = sim.store();
+  const Integrator integ(TimeStepping::per_level, TaitEquationOfState{});
+  const double cfl = 0.2;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> decades(-3.0, 0.0);
+  for (std::size_t i = 0; i < s.size(); ++i) s.dt_limit[i] = 1e-3 * std::pow(10.0, decades(rng));
+  s.dt_limit[0] = 0.0;
+  s.dt_limit[1] = std::numeric_limits<double>::quiet_NaN();
+  std::set<int> seen;
+  std::size_t moved = 0;  // particles whose bin differs between the first and the last candidate
+  for (const double target : {2e-4, 1.3e-3, 7e-3, std::numeric_limits<double>::infinity()}) {
+    std::array<double, Integrator::kShrinks> candidate{};
+    for (int k = 0; k < Integrator::kShrinks; ++k) candidate[static_cast<std::size_t>(k)] = target * Integrator::shrink(k);
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      std::array<int, Integrator::kShrinks> bins{};
+      integ.bins_for_shares(s.view(), i, candidate, cfl, bins);
+      for (std::size_t k = 0; k < bins.size(); ++k) {
+        ASSERT_EQ(bins[k], integ.bin_for(s.view(), i, candidate[k], cfl)) << "particle " << i << ", candidate " << k;
+        seen.insert(bins[k]);
+      }
+      moved += bins.front() != bins.back();
+    }
+  }
+  // The premise of the comparison: bins from the coarsest to the cap, and candidates that move particles a bin.
+  EXPECT_TRUE(seen.count(0) && seen.count(Integrator::kMaxBin));
+  EXPECT_GT(moved, s.size() / 10);
 }
 
 // With bin_jump = 1 (the default), over 200 coarse steps of the three-level cloud with the last-rate predictor
