@@ -89,4 +89,10 @@ std::unique_ptr<SweepBase<D>> make_sweep(const SolverSettingsT<D>& s) {
   return sweep_detail::with_stress(base, s, "continuity+pressure");
 }
 
+// Instantiated once, in the library (core/simulation_2d.cpp, core/simulation_3d.cpp): every pack of effects is a
+// sweep of its own, six loops each, and a test or benchmark that called make_sweep compiled them all again (the
+// partition test alone took a minute to compile).
+extern template std::unique_ptr<SweepBase<2>> make_sweep<2>(const SolverSettingsT<2>&);
+extern template std::unique_ptr<SweepBase<3>> make_sweep<3>(const SolverSettingsT<3>&);
+
 }  // namespace sph
