@@ -10,7 +10,9 @@ like with like; a run shorter than 30 s is repeated and its best of three wall t
 reruns only those). --quick drops the 16x resolution, the finest and the no-slip Martin & Moyce columns, the 4x
 coarsening variants and Lobovsky's RSP run, and runs each variant once (under 15 minutes on two cores, the report
 included); --skip-runs reuses results/validation;
---only reruns the named cases (dam_break, drop, mm_column, lobovsky) and reuses the stored runs of the others.
+--only reruns the named cases (dam_break, drop, dam_break_courant, drop_courant, mm_column, lobovsky) and reuses the
+stored runs of the others (the _courant cases: AAP with one global step and per level at two more Courant numbers,
+for the probes' spread).
 
 For the dam break and the drop it also samples every run's frames against a converged reference (the fully
 refined run at 16x, or at 4x with --quick) and charts each run's velocity field error against its cost, the
@@ -103,6 +105,41 @@ def variants_for(case, scene, spacings, threshold, quick, extra=()):
                 v.append((f"aap_v{threshold * f:g}",
                           [f"effects.refinement={refinement('aap', threshold * f)}"], k))
     return [(case, scene, name, ov + list(extra), k) for name, ov, k in v]
+
+
+# The Courant numbers at which AAP with one global step and AAP per level run again at the paper's counts, besides
+# their scenes' 0.2: only the time step changes, not the flow's physics, so what the probes' errors do across them is
+# the spread a single run's error carries (a probe that follows one particle, as H does, moves with it).
+COURANT_SPREAD = (0.1, 0.15)
+
+
+def courant_variants(case, scene, threshold, extra):
+    """(case_courant, scene, name, overrides, 1): AAP and AAP per level at each of COURANT_SPREAD, in a case of their
+    own so that the tables of the case's variants do not list them (courant_spread reads them)."""
+    jobs = []
+    for c in COURANT_SPREAD:
+        for name, ov in (("aap", []), ("aap_pl", ["time.stepping=per_level"])):
+            jobs.append((case + "_courant", scene, f"{name}_c{c:g}",
+                         [f"effects.refinement={refinement('aap', threshold, 1.0)}"] + ov + list(extra) +
+                         [f"time.cfl={c!r}"], 1))
+    return jobs
+
+
+def courant_spread(R, spread, windows):
+    """Each probe's error against the fully refined run (summarise's definition and windows) for AAP with one global
+    step and per level at COURANT_SPREAD and at the scene's own Courant number (R's aap and aap_pl): {variant:
+    {probe: [errors]}}; empty where a run is missing."""
+    ref = R.get("refined")
+    out = {}
+    for name in ("aap", "aap_pl"):
+        found = [spread.get(f"{name}_c{c:g}") for c in COURANT_SPREAD] + [R.get(name)]
+        if ref is None or any(r is None for r in found):
+            continue
+        rs = ref["series"]
+        out[name] = {probe: [lq.probe_error(r["series"]["time"], r["series"][probe], rs["time"], rs[probe], start,
+                                            end(rs) if end else None)[0] for r in found]
+                     for probe, (start, end) in windows.items()}
+    return out
 
 
 def run_variant(job, repeats=REPEATS_SHORT):
@@ -598,6 +635,25 @@ def findings_section(f):
                        "particles, most of the moving fluid once the velocity criterion has marked it, take as many as "
                        "with one global step, so the saving is bounded by the coarse share of the particles (target: "
                        "35 % for the dam break, 45 % for the drop, at the paper's counts).")
+        spread = f.get(case + "_courant")
+        if spread and "aap" in spread and "aap_pl" in spread:
+            courants = ", ".join(f"{c:g}" for c in COURANT_SPREAD)
+
+            def span(errs):
+                return (f"{100 * min(errs):.2f}-{100 * max(errs):.2f} % (mean {100 * np.mean(errs):.2f} %)")
+
+            parts = []
+            for probe in spread["aap"]:
+                g, l = spread["aap"][probe], spread["aap_pl"][probe]
+                apart = min(l) > max(g) or min(g) > max(l)
+                parts.append(f"{probe} one global step {span(g)}, per level {span(l)}"
+                             + (" (apart)" if apart else " (overlapping)"))
+            out.append(f"- {case}, the probes' spread at the paper's counts: AAP with one global step and per level "
+                       f"again at Courant numbers {courants} beside the scene's 0.2 (the time step alone changes), "
+                       "RMS against the fully refined run as above, smallest to largest of the three: "
+                       + "; ".join(parts) + ". Where two variants' ranges overlap, one run of each cannot order "
+                       "their accuracy by that probe (docs/PERFORMANCE.md, \"At unchanged accuracy: the probes' "
+                       "spread\").")
     for key, label in (("dam_break_local", "Breaking dam"), ("drop_local", "Drop")):
         if f.get(key):
             out += local_findings(label, f[key])
@@ -759,6 +815,7 @@ def build_jobs(quick):
     jobs = []
     for case, (scene, spacings, thr, extra) in cases.items():
         jobs += variants_for(case, scene, spacings, thr, quick, extra)
+        jobs += courant_variants(case, scene, thr, extra)
     # Martin & Moyce's 2:1 column: a resolution study of the fully refined run and the dynamic run.
     mm_thr = 10.0 / math.sqrt(G * H0_DAM) * math.sqrt(G * 2.0)  # the dam's threshold at the same Froude number
     for k, tag in ((0.5, "_a15"), (1, ""), (2, "_a60")):
@@ -850,7 +907,9 @@ def main():
         print(f"running {len(order)} variants, {args.jobs} at a time, 1 thread each", flush=True)
         with ThreadPoolExecutor(max_workers=args.jobs) as pool:
             # The quick form runs each variant once: its timings are single runs.
-            list(pool.map(lambda j: run_variant(j, 1 if args.quick else REPEATS_SHORT), order))
+            # So do the Courant spread's runs (courant_variants): only their probes are read, not their times.
+            list(pool.map(lambda j: run_variant(j, 1 if args.quick or j[0].endswith("_courant") else REPEATS_SHORT),
+                          order))
 
     report_start = time.monotonic()
     runs = {}
@@ -896,6 +955,7 @@ def main():
 
         dam_windows = {"H": (None, None), "Z": (None, front_at_far_wall)}
         rows = summarise("dam_break", R, dam_windows)
+        findings["dam_break_courant"] = courant_spread(R, runs.get("dam_break_courant", {}), dam_windows)
         fig, axes = plt.subplots(1, 2, figsize=(11, 4))
         for name in ("unrefined", "refined", "aap", "rsp"):
             if name in R:
@@ -1004,6 +1064,8 @@ def main():
         depth = 10.0
         drop_windows = {"H": (0.35, None), "H_left_wall": (None, None), "crown": (0.35, None)}
         rows = summarise("drop", R, {k: drop_windows[k] for k in ("H", "H_left_wall")})
+        findings["drop_courant"] = courant_spread(R, runs.get("drop_courant", {}),
+                                                  {k: drop_windows[k] for k in ("H", "H_left_wall")})
         fig, axes = plt.subplots(1, 2, figsize=(12, 4))
         for name in ("unrefined", "refined", "aap", "rsp"):
             if name in R:
