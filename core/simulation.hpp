@@ -204,6 +204,7 @@ class SimulationT {
   RemovedFluid removed_, last_good_removed_;
   // Step workspace of prepare_neighbours (reused, so a step allocates nothing once sizes settle).
   std::vector<std::uint32_t> expand_src_, expand_offsets_;
+  std::vector<std::uint32_t> gather_from_;  // build_neighbours: each slot's store index before the build
   std::vector<std::uint32_t> due_prefix_;  // Activity::due_prefix of the current substep
   std::vector<std::uint32_t> due_index_;   // Activity::due_index of the current substep
   Integrator::BinLimiterWork bin_limiter_;  // Integrator::limit_bins' workspace
