@@ -20,7 +20,6 @@ part, not where two single runs do.
 """
 import argparse
 import concurrent.futures
-import csv
 import os
 import subprocess
 import sys
@@ -31,12 +30,7 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 import local_quantities as lq  # noqa: E402
-
-
-def series(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]}
+from read_output import load_series  # noqa: E402
 
 
 def run(app, scene, overrides, out):
@@ -46,7 +40,7 @@ def run(app, scene, overrides, out):
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed: {r.stderr.strip()}")
-    return series(os.path.join(out, "series.csv"))
+    return load_series(out)
 
 
 def main():
