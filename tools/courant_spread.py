@@ -3,7 +3,7 @@
 tells a real difference between two variants from a single run's luck. For docs/PERFORMANCE.md, "At unchanged
 accuracy: the probes' spread" (issue #16).
 
-    /usr/bin/python3 tools/courant_spread.py --reference SCENE [--courant 0.1 0.15 0.18 0.2] [--probe H ...] RUN [RUN ...]
+    /usr/bin/python3 tools/courant_spread.py --reference SCENE [--courant 0.1,0.15,0.18,0.2] [--probe H ...] RUN [RUN ...]
 
 A RUN is a scene file followed by its --set overrides, separated by commas, as for tools/work_counters.py:
     cases/dam_break_aap.json,time.stepping=per_level
@@ -47,16 +47,20 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("runs", nargs="+")
     ap.add_argument("--reference", required=True, help="the reference scene (run at its own Courant number)")
-    ap.add_argument("--courant", type=float, nargs="+", default=[0.1, 0.15, 0.18, 0.2])
+    ap.add_argument("--courant", default="0.1,0.15,0.18,0.2", help="comma-separated Courant numbers")
     ap.add_argument("--probe", action="append", help="a series.csv column (default: H)")
     ap.add_argument("--app", default=os.path.join(ROOT, "build", "release", "app", "sphrefine"))
     args = ap.parse_args()
     probes = args.probe or ["H"]
     if not os.access(args.app, os.X_OK):
         sys.exit(f"--app {args.app}: not an executable (build the release preset first)")
+    try:
+        args.courant = [float(c) for c in args.courant.split(",")]
+    except ValueError:
+        sys.exit(f"--courant {args.courant}: not a comma-separated list of numbers")
     for c in args.courant:
         if not 0.0 < c <= 1.0:
-            sys.exit(f"--courant {c}: must lie in (0, 1]")
+            sys.exit(f"--courant {c:g}: must lie in (0, 1]")
     specs = [s.split(",") for s in args.runs]
     for spec in specs + [[args.reference]]:
         if not os.path.exists(os.path.join(ROOT, spec[0])):
