@@ -369,14 +369,14 @@ void SimulationT<D>::copy_next_bins_to_ghosts() {
   if (!ghosts_) return;
   const auto s = store_.view();
   const std::uint32_t* order = grid_.order().data();
-  const std::uint32_t* src = expand_src_.data();
+  const std::uint32_t* from = gather_from_.data();  // each slot's store index before the build
   const std::int8_t* image = expand_image_.data();
   ghost_source_.resize(expand_offsets_.size() - 1);  // one entry per particle of the store before the build
   par::parallel_for(s.n, [&](std::size_t k) {
-    if (image[order[k]] < 0) ghost_source_[src[order[k]]] = static_cast<std::uint32_t>(k);
+    if (image[order[k]] < 0) ghost_source_[from[k]] = static_cast<std::uint32_t>(k);
   });
   par::parallel_for(s.n, [&](std::size_t k) {
-    if (image[order[k]] >= 0) s.next_bin[k] = s.next_bin[ghost_source_[src[order[k]]]];
+    if (image[order[k]] >= 0) s.next_bin[k] = s.next_bin[ghost_source_[from[k]]];
   });
 }
 

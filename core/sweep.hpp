@@ -285,8 +285,8 @@ class PairSweep {
             // 2^-b_ij scales every fluid pair term (each is linear in grad W); a power of two, so exact.
             pr.weight = kBinWeight[static_cast<std::size_t>(bij)];
             pr.gradW = (pr.weight * factor) * xij;
-            // Into i's own class (acc), or for a particle that is not due its kick alone; else a finer class. One
-            // copy of the effects' code for both: two cost a tenth of this file's compile time.
+            // Into i's own class (acc), or for a particle that is not due its kick alone; else a finer class: one
+            // copy of the effects' code for both.
             PairSums<D>* into = &acc;
             if (Top || bij == bi || !due) {
               own_used = true;
