@@ -14,40 +14,79 @@
 
 namespace sph {
 
-/// Raw pointers into the store for hot loops. Valid until the store is resized or gathered.
+// The one list of the store's fields, in registry order: X(type, member, name, unit). The members, the registry
+// (field_members(), behind for_each_field), the hot loops' view (ParticleView, view()) and bytes_per_particle() are
+// all made from it, so a field added here is carried by every operation: resize, gather (permutation, compaction,
+// expansion), append, copies, exchange across ranks, output and checkpoints. `VecD` is Vec<D>.
+//
+// What the fields hold:
+// - x, v, rho, p, m, h, d, level, kind, id: the particle itself. m is per metre of depth in 2D (rho0 d^2), as
+//   energies are J/m.
+// - drho, a: the rates of its last evaluation.
+// - vh, rhoh: the integrator's stage state (kick-drift-kick), the velocity and density at the half step.
+// - level_time: when the particle took its level (its split, or the merge that made it); 0 for the set-up's
+//   particles. Coarsening holds a family at its level for a minimum time (core/refinement/merge_pass.hpp).
+// - origin (core/types.hpp): a fresh merge is not split at the next check.
+// - kick, kick_rho: the pair sweep's weighted sums (core/sweep.hpp); the integrator kicks v and rho by dt0 times
+//   them. Equal to a and drho with one global step; with time bins they hold only the pairs due at the current
+//   substep.
+// - bin, next_bin, stiffness, dt_limit: time bins (core/integrator.hpp). The particle steps dt0 / 2^bin this step;
+//   next_bin is the bin of the next step, chosen before the step's last evaluation (Simulation::choose_bins) from
+//   the particle's own time-step limit dt_limit (min of its force and acoustic limits, unscaled) and its acoustic
+//   stiffness h_i / L_i >= 1 (core/kernel.hpp, LatticeGradientSum::acoustic_length), both from its last evaluation.
+//   Bins are 0 with one global step.
+// - jerk, density_jerk: the change of a and drho between the particle's last two evaluations over the time between
+//   them (core/sweep.hpp); the extrapolated predictor (Integrator::drift) integrates a + t jerk. Zero before a
+//   particle's second evaluation in a run and after a merge; a daughter keeps its parent's.
+// - role (core/types.hpp).
+// - tie: a daughter's place relative to its parent when its split put it there (zero for the set-up's particles
+//   and a merge's). A buffer particle (buffered coupling) keeps that place: it moves with its host
+//   (core/refinement/buffer.hpp).
+// - full_a, full_drho, v_open, rho_open: time bins. The rates of every pair at full weight, whatever its bin (a and
+//   drho weigh a pair of a finer bin than the particle's by 2^(b_i - b_ij), as its opening kick needs; equal to
+//   them where every pair is in the particle's own bin), and the velocity and density at the start of the
+//   particle's current step. Between its own evaluations the integrator predicts v and rho from them
+//   (Integrator::drift).
+#define SPH_PARTICLE_FIELDS(X)                                        \
+  X(VecD, x, "position", "m")                                         \
+  X(VecD, v, "velocity", "m/s")                                       \
+  X(double, rho, "density", "kg/m^3")                                 \
+  X(double, p, "pressure", "Pa")                                      \
+  X(double, m, "mass", D == 2 ? "kg/m" : "kg")                        \
+  X(double, h, "smoothing_length", "m")                               \
+  X(double, d, "spacing", "m")                                        \
+  X(std::int32_t, level, "level", "1")                                \
+  X(Kind, kind, "kind", "1")                                          \
+  X(ParticleId, id, "id", "1")                                        \
+  X(double, drho, "density_rate", "kg/m^3/s")                         \
+  X(VecD, a, "acceleration", "m/s^2")                                 \
+  X(VecD, vh, "velocity_half", "m/s")                                 \
+  X(double, rhoh, "density_half", "kg/m^3")                           \
+  X(double, level_time, "level_time", "s")                            \
+  X(Origin, origin, "origin", "1")                                    \
+  X(VecD, kick, "kick_rate", "m/s^2")                                 \
+  X(double, kick_rho, "kick_density_rate", "kg/m^3/s")                \
+  X(std::int32_t, bin, "time_bin", "1")                               \
+  X(std::int32_t, next_bin, "next_time_bin", "1")                     \
+  X(double, stiffness, "acoustic_stiffness", "1")                     \
+  X(double, dt_limit, "time_step_limit", "s")                         \
+  X(VecD, jerk, "jerk", "m/s^3")                                      \
+  X(double, density_jerk, "density_jerk", "kg/m^3/s^2")              \
+  X(Role, role, "role", "1")                                          \
+  X(VecD, tie, "tie_offset", "m")                                     \
+  X(VecD, full_a, "acceleration_all_pairs", "m/s^2")                  \
+  X(double, full_drho, "density_rate_all_pairs", "kg/m^3/s")          \
+  X(VecD, v_open, "velocity_at_step_start", "m/s")                    \
+  X(double, rho_open, "density_at_step_start", "kg/m^3")
+
+/// Raw pointers into the store for hot loops, one per field. Valid until the store is resized or gathered.
 template <int D>
 struct ParticleView {
+  using VecD = Vec<D>;
   std::size_t n = 0;
-  Vec<D>* x = nullptr;
-  Vec<D>* v = nullptr;
-  double* rho = nullptr;
-  double* p = nullptr;
-  double* m = nullptr;
-  double* h = nullptr;
-  double* d = nullptr;
-  std::int32_t* level = nullptr;
-  Kind* kind = nullptr;
-  ParticleId* id = nullptr;
-  double* drho = nullptr;
-  Vec<D>* a = nullptr;
-  Vec<D>* vh = nullptr;
-  double* rhoh = nullptr;
-  double* level_time = nullptr;
-  Origin* origin = nullptr;
-  Vec<D>* kick = nullptr;
-  double* kick_rho = nullptr;
-  std::int32_t* bin = nullptr;
-  std::int32_t* next_bin = nullptr;
-  double* stiffness = nullptr;
-  double* dt_limit = nullptr;
-  Vec<D>* jerk = nullptr;
-  double* density_jerk = nullptr;
-  Role* role = nullptr;
-  Vec<D>* tie = nullptr;
-  Vec<D>* full_a = nullptr;
-  double* full_drho = nullptr;
-  Vec<D>* v_open = nullptr;
-  double* rho_open = nullptr;
+#define SPH_VIEW_POINTER(T, member, name, unit) T* member = nullptr;
+  SPH_PARTICLE_FIELDS(SPH_VIEW_POINTER)
+#undef SPH_VIEW_POINTER
 };
 
 template <int D>
@@ -56,70 +95,16 @@ class ParticleStore {
   static constexpr int dim = D;
   using VecD = Vec<D>;
 
-  // The fields, each with its name and unit. Adding one here (and to for_each_field) is all it takes for every
-  // operation to carry it.
-  Field<VecD> x{"position", "m"};
-  Field<VecD> v{"velocity", "m/s"};
-  Field<double> rho{"density", "kg/m^3"};
-  Field<double> p{"pressure", "Pa"};
-  Field<double> m{"mass", D == 2 ? "kg/m" : "kg"};  // 2D: per metre of depth (rho0 d^2), as energies are J/m
-  Field<double> h{"smoothing_length", "m"};
-  Field<double> d{"spacing", "m"};
-  Field<std::int32_t> level{"level", "1"};
-  Field<Kind> kind{"kind", "1"};
-  Field<ParticleId> id{"id", "1"};
-  Field<double> drho{"density_rate", "kg/m^3/s"};
-  Field<VecD> a{"acceleration", "m/s^2"};
-  // Integrator stage state (kick-drift-kick): velocity and density at the half step.
-  Field<VecD> vh{"velocity_half", "m/s"};
-  Field<double> rhoh{"density_half", "kg/m^3"};
-  // When the particle took its level (its split, or the merge that made it); 0 for the set-up's particles.
-  // Coarsening holds a family at its level for a minimum time (core/refinement/merge_pass.hpp).
-  Field<double> level_time{"level_time", "s"};
-  Field<Origin> origin{"origin", "1"};  // core/types.hpp: a fresh merge is not split at the next check
-  // The pair sweep's weighted sums (core/sweep.hpp): the integrator kicks v and rho by dt0 times them. Equal to
-  // a and drho with one global step; with time bins they hold only the pairs due at the current substep.
-  Field<VecD> kick{"kick_rate", "m/s^2"};
-  Field<double> kick_rho{"kick_density_rate", "kg/m^3/s"};
-  // Time bins (core/integrator.hpp): the particle steps dt0 / 2^bin this step; next_bin is the bin of the next
-  // step, chosen before the step's last evaluation (Simulation::choose_bins) from the particle's own time-step
-  // limit dt_limit (min of its force and acoustic limits, unscaled) and its acoustic stiffness h_i / L_i >= 1
-  // (core/kernel.hpp, LatticeGradientSum::acoustic_length), both from its last evaluation. Bins are 0 with one
-  // global step.
-  Field<std::int32_t> bin{"time_bin", "1"};
-  Field<std::int32_t> next_bin{"next_time_bin", "1"};
-  Field<double> stiffness{"acoustic_stiffness", "1"};
-  Field<double> dt_limit{"time_step_limit", "s"};
-  // The change of a and drho between the particle's last two evaluations over the time between them (core/sweep.hpp);
-  // the extrapolated predictor (Integrator::drift) integrates a + t jerk. Zero before a particle's second evaluation
-  // in a run and after a merge; a daughter keeps its parent's.
-  Field<VecD> jerk{"jerk", "m/s^3"};
-  Field<double> density_jerk{"density_jerk", "kg/m^3/s^2"};
-  Field<Role> role{"role", "1"};  // core/types.hpp
-  // A daughter's place relative to its parent when its split put it there (zero for the set-up's particles and a
-  // merge's). A buffer particle (buffered coupling) keeps that place: it moves with its host (core/refinement/buffer.hpp).
-  Field<VecD> tie{"tie_offset", "m"};
-  // Time bins: the rates of every pair at full weight, whatever its bin (a and drho weigh a pair of a finer bin than
-  // the particle's by 2^(b_i - b_ij), as its opening kick needs; equal to them where every pair is in the particle's
-  // own bin), and the velocity and density at the start of the particle's current step. Between its own evaluations
-  // the integrator predicts v and rho from them (Integrator::drift).
-  Field<VecD> full_a{"acceleration_all_pairs", "m/s^2"};
-  Field<double> full_drho{"density_rate_all_pairs", "kg/m^3/s"};
-  Field<VecD> v_open{"velocity_at_step_start", "m/s"};
-  Field<double> rho_open{"density_at_step_start", "kg/m^3"};
+  // The fields (SPH_PARTICLE_FIELDS above), each with its name and unit.
+#define SPH_FIELD_MEMBER(T, member, name, unit) Field<T> member{name, unit};
+  SPH_PARTICLE_FIELDS(SPH_FIELD_MEMBER)
+#undef SPH_FIELD_MEMBER
 
-  /// The registry: every field as a pointer to member. Adding a field above and here is all it takes for
-  /// every operation (gather, compaction, expansion, copies, output, checkpoints) to carry it.
+  /// The registry: every field as a pointer to member, in SPH_PARTICLE_FIELDS' order.
   static constexpr auto field_members() {
-    return std::make_tuple(&ParticleStore::x, &ParticleStore::v, &ParticleStore::rho, &ParticleStore::p,
-                           &ParticleStore::m, &ParticleStore::h, &ParticleStore::d, &ParticleStore::level,
-                           &ParticleStore::kind, &ParticleStore::id, &ParticleStore::drho, &ParticleStore::a,
-                           &ParticleStore::vh, &ParticleStore::rhoh, &ParticleStore::level_time,
-                           &ParticleStore::origin, &ParticleStore::kick, &ParticleStore::kick_rho,
-                           &ParticleStore::bin, &ParticleStore::next_bin, &ParticleStore::stiffness,
-                           &ParticleStore::dt_limit, &ParticleStore::jerk, &ParticleStore::density_jerk,
-                           &ParticleStore::role, &ParticleStore::tie, &ParticleStore::full_a,
-                           &ParticleStore::full_drho, &ParticleStore::v_open, &ParticleStore::rho_open);
+#define SPH_FIELD_POINTER(T, member, name, unit) , std::make_tuple(&ParticleStore::member)
+    return std::tuple_cat(std::tuple<>() SPH_PARTICLE_FIELDS(SPH_FIELD_POINTER));
+#undef SPH_FIELD_POINTER
   }
 
   /// Visits every field. f is called with each Field<T>&.
@@ -232,11 +217,12 @@ class ParticleStore {
   }
 
   ParticleView<D> view() {
-    return {size(), x.data(), v.data(), rho.data(), p.data(), m.data(), h.data(), d.data(),
-            level.data(), kind.data(), id.data(), drho.data(), a.data(), vh.data(), rhoh.data(), level_time.data(),
-            origin.data(), kick.data(), kick_rho.data(), bin.data(), next_bin.data(), stiffness.data(), dt_limit.data(),
-            jerk.data(), density_jerk.data(), role.data(), tie.data(), full_a.data(), full_drho.data(), v_open.data(),
-            rho_open.data()};
+    ParticleView<D> out;
+    out.n = size();
+#define SPH_VIEW_DATA(T, member, name, unit) out.member = member.data();
+    SPH_PARTICLE_FIELDS(SPH_VIEW_DATA)
+#undef SPH_VIEW_DATA
+    return out;
   }
 
   /// Bytes held by every field (data and scratch), for memory reports.
@@ -248,12 +234,15 @@ class ParticleStore {
 
   /// Bytes one particle occupies across all fields.
   static constexpr std::size_t bytes_per_particle() {
-    return 9 * sizeof(VecD) + 14 * sizeof(double) + 3 * sizeof(std::int32_t) + sizeof(Kind) + sizeof(ParticleId) +
-           sizeof(Origin) + sizeof(Role);
+#define SPH_FIELD_BYTES(T, member, name, unit) +sizeof(T)
+    return 0 SPH_PARTICLE_FIELDS(SPH_FIELD_BYTES);
+#undef SPH_FIELD_BYTES
   }
 
  private:
   ParticleId next_id_ = 0;
 };
+
+#undef SPH_PARTICLE_FIELDS
 
 }  // namespace sph
