@@ -30,13 +30,25 @@ def is_uniform(name):
     return name.startswith("unrefined") or name.startswith("refined")
 
 
-def field_rows(R, reference, d0, box, window, cost):
+class FieldErrors:
+    """The field errors of runs against one reference run (its output folder), each frame sampled on the lattice of
+    two points per coarse spacing d0 over box (x0, y0, x1, y1), over the frames in window (t0, t1)."""
+
+    def __init__(self, reference_out, d0, box, window):
+        self.lattice = field_error.Lattice(box[:2], box[2:], d0 / 2.0)
+        self.window = window
+        self.ref = field_error.sampled_frames(reference_out, self.lattice, window)
+
+    def of(self, out):
+        """{E_v, E_p, E_phi, ...} of the run whose output folder is out."""
+        return field_error.errors(field_error.sampled_frames(out, self.lattice, self.window), self.ref)
+
+
+def field_rows(R, reference, d0, fe, cost):
     """Rows for every run of case R (name -> run dict with "out", "k", "summary", "series") finer-grained than the
-    reference excluded: name, uniform, finest spacing, wall, evaluations, E_v, E_p, E_phi, frames."""
-    ref_run = R[reference]
-    h_ref = finest_spacing(reference, ref_run["k"], d0)
-    lattice = field_error.Lattice(box[:2], box[2:], d0 / 2.0)  # two points per coarse spacing
-    ref = field_error.sampled_frames(ref_run["out"], lattice, window)
+    reference excluded: name, uniform, finest spacing, wall, evaluations, E_v, E_p, E_phi, frames. fe: the
+    FieldErrors against R[reference]."""
+    h_ref = finest_spacing(reference, R[reference]["k"], d0)
     rows = []
     for name, r in R.items():
         spacing = finest_spacing(name, r["k"], d0)
@@ -44,7 +56,7 @@ def field_rows(R, reference, d0, box, window, cost):
             continue  # not coarser than the reference: not on the chart
         if not os.path.isdir(os.path.join(r["out"], "frames")):
             continue
-        e = field_error.errors(field_error.sampled_frames(r["out"], lattice, window), ref)
+        e = fe.of(r["out"])
         wall, evals = cost(r)
         completed = r["summary"].get("status", "completed") == "completed"
         rows.append(dict(name=name, uniform=is_uniform(name), spacing=spacing, wall=wall, evaluations=evals,

@@ -128,6 +128,12 @@ def courant_variants(case, scene, threshold, extra):
     return jobs
 
 
+def courant_runs(R, spread, name):
+    """The runs of variant name at each of COURANT_SPREAD (spread: the case's _courant runs), then at the scene's own
+    Courant number (R's); None where one is missing."""
+    return [spread.get(f"{name}_c{c:g}") for c in COURANT_SPREAD] + [R.get(name)]
+
+
 def courant_spread(R, spread, windows):
     """Each probe's error against the fully refined run (summarise's definition and windows) for AAP with one global
     step and per level at COURANT_SPREAD and at the scene's own Courant number (R's aap and aap_pl): {variant:
@@ -135,7 +141,7 @@ def courant_spread(R, spread, windows):
     ref = R.get("refined")
     out = {}
     for name in ("aap", "aap_pl"):
-        found = [spread.get(f"{name}_c{c:g}") for c in COURANT_SPREAD] + [R.get(name)]
+        found = courant_runs(R, spread, name)
         if ref is None or any(r is None for r in found):
             continue
         rs = ref["series"]
@@ -307,8 +313,10 @@ def cost_chart(case, rows, err_key, out_png, title):
 
 
 # ----------------------------------------------------------------------------------------------- accuracy vs cost
-def pareto_section(case, label, R, d0, box, window, window_text, quick, fig_name):
-    """The accuracy-against-cost chart and table of a case (tools/pareto.py), and its one-paragraph answer."""
+def pareto_section(case, label, R, d0, box, window, window_text, quick, fig_name, spread=None):
+    """The accuracy-against-cost chart and table of a case (tools/pareto.py), and its one-paragraph answer. With
+    spread (courant_spread's findings and the case's _courant runs), each variant's E_v at every Courant number joins
+    its probes there."""
     reference = "refined_x4" if quick else "refined_x16"
     if reference not in R:
         return f"No accuracy-against-cost chart: the reference run {reference} is missing.\n", ""
@@ -316,7 +324,12 @@ def pareto_section(case, label, R, d0, box, window, window_text, quick, fig_name
     def cost(r):
         return r["summary"]["wall_seconds"], evaluations(r["summary"], r["series"])
 
-    rows = pareto.field_rows(R, reference, d0, box, window, cost)
+    fe = pareto.FieldErrors(R[reference]["out"], d0, box, window)
+    rows = pareto.field_rows(R, reference, d0, fe, cost)
+    if spread is not None:
+        found, runs = spread
+        for name in found:
+            found[name]["E_v"] = [fe.of(r["out"])["E_v"] for r in courant_runs(R, runs, name)]
     pareto.chart(rows, reference, f"{label}: velocity field error against cost",
                  os.path.join(FIGURES, fig_name))
     ver = {v["name"]: v for v in pareto.verdicts(rows)}
@@ -652,9 +665,12 @@ def findings_section(f):
                 apart = min(l) > max(g) or min(g) > max(l)
                 parts.append(f"{probe} one global step {span(g)}, per level {span(l)}"
                              + (" (apart)" if apart else " (overlapping)"))
+            field = (" and the velocity field error E_v against the chart's reference (as in the accuracy-against-cost "
+                     "table)" if "E_v" in spread["aap"] else "")
             out.append(f"- {case}, the probes' spread at the paper's counts: AAP with one global step and per level "
                        f"again at Courant numbers {courants} beside the scene's 0.2 (the time step alone changes), "
-                       f"RMS against the fully refined run as above, smallest to largest of the {len(COURANT_SPREAD) + 1}: "
+                       f"each probe's RMS against the fully refined run as above{field}, smallest to largest of the "
+                       f"{n_spread} runs: "
                        + "; ".join(parts) + ". \"Apart\" (every run of one variant beats every run of the other) "
                        f"happens by chance to two variants of the same accuracy with probability 1 in "
                        f"{math.comb(2 * n_spread, n_spread) // 2}. Where two variants' ranges overlap, one run of each "
@@ -1019,7 +1035,8 @@ def main():
         findings["dam_break"] = rows
         text, answer = pareto_section("dam_break", "Breaking dam", R, 25.0 / 30.0, (0.0, 0.0, 50.0, 50.0),
                                       (0.25 * T, 1e9), "t sqrt(g / H0) >= 0.25 (before it the column has barely "
-                                      "moved and every run agrees)", args.quick, "validation_dam_pareto.png")
+                                      "moved and every run agrees)", args.quick, "validation_dam_pareto.png",
+                                      (findings["dam_break_courant"], runs.get("dam_break_courant", {})))
         md.append(text)
         answers.append(answer)
         md.append("### Local quantities: the impact on the far wall and the run-up\n")
@@ -1119,7 +1136,8 @@ def main():
         findings["drop"] = rows
         text, answer = pareto_section("drop", "Splash of a drop", R, 25.0 / 30.0, (-12.5, 0.0, 12.5, 20.0),
                                       (0.35, 1e9), "t >= 0.35 s (the drop reaches the pool then; before it only "
-                                      "the pool at rest and the falling drop)", args.quick, "validation_drop_pareto.png")
+                                      "the pool at rest and the falling drop)", args.quick, "validation_drop_pareto.png",
+                                      (findings["drop_courant"], runs.get("drop_courant", {})))
         md.append(text)
         answers.append(answer)
         md.append("### Local quantities: the cavity and the crown\n")
