@@ -8,10 +8,10 @@ then writes the probe CSVs, the figures (docs/figures/validation_*.png) and docs
 Every run uses one OpenMP thread and two runs go side by side, so the wall times of the variants compare
 like with like; a run shorter than 30 s is repeated and its best of three wall times kept (--retime-short
 reruns only those). --quick drops the 16x resolution, the finest and the no-slip Martin & Moyce columns, the 4x
-coarsening variants and Lobovsky's RSP run, and runs each variant once (under 15 minutes on two cores, the report
+coarsening variants and Lobovsky's RSP run, and runs each variant once (about 17 minutes on two cores, the report
 included); --skip-runs reuses results/validation;
 --only reruns the named cases (dam_break, drop, dam_break_courant, drop_courant, mm_column, lobovsky) and reuses the
-stored runs of the others (the _courant cases: AAP with one global step and per level at two more Courant numbers,
+stored runs of the others (the _courant cases: AAP with one global step and per level at five more Courant numbers,
 for the probes' spread).
 
 For the dam break and the drop it also samples every run's frames against a converged reference (the fully
@@ -104,6 +104,11 @@ def variants_for(case, scene, spacings, threshold, quick, extra=()):
             for f in (0.5, 1.5, 2.0):
                 v.append((f"aap_v{threshold * f:g}",
                           [f"effects.refinement={refinement('aap', threshold * f)}"], k))
+            # Per level at 1.5x the threshold as well: issue #16's time targets are met there and not at the
+            # paper's threshold (docs/PERFORMANCE.md, "What the targets need: fewer refined particles"), so the
+            # report shows what that costs in accuracy.
+            v.append((f"aap_pl_v{threshold * 1.5:g}",
+                      [f"effects.refinement={refinement('aap', threshold * 1.5, 1.0)}", "time.stepping=per_level"], k))
     return [(case, scene, name, ov + list(extra), k) for name, ov, k in v]
 
 
@@ -651,6 +656,14 @@ def findings_section(f):
                        "particles, most of the moving fluid once the velocity criterion has marked it, take as many as "
                        "with one global step, so the saving is bounded by the coarse share of the particles (target: "
                        "35 % for the dam break, 45 % for the drop, at the paper's counts).")
+        for r in rows:
+            if r["name"].startswith("aap_pl_v") and r["status"] == "completed":
+                out.append(f"- {case}, per level at 1.5x the velocity threshold ({r['name']}): "
+                           f"{100 * r['rel_time']:.0f} % of the fully refined run's time, evaluations "
+                           f"{100 * r['rel_psteps']:.0f} %, RMS "
+                           + ", ".join(f"{p[4:]} {100 * r[p]:.1f} %" for p in probes)
+                           + ". Fewer particles are refined than at the paper's threshold; its accuracy against the "
+                           "converged reference is in the accuracy-against-cost table (E_v).")
         spread = f.get(case + "_courant")
         if spread and "aap" in spread and "aap_pl" in spread:
             courants = ", ".join(f"{c:g}" for c in COURANT_SPREAD)
