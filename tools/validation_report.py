@@ -8,7 +8,7 @@ then writes the probe CSVs, the figures (docs/figures/validation_*.png) and docs
 Every run uses one OpenMP thread and two runs go side by side, so the wall times of the variants compare
 like with like; a run shorter than 30 s is repeated and its best of three wall times kept (--retime-short
 reruns only those). --quick drops the 16x resolution, the finest and the no-slip Martin & Moyce columns, the 4x
-coarsening variants and Lobovsky's RSP run, and runs each variant once (about 17 minutes on two cores, the report
+coarsening variants and Lobovsky's RSP run, and runs each variant once (about 20 minutes on two cores, the report
 included); --skip-runs reuses results/validation;
 --only reruns the named cases (dam_break, drop, dam_break_courant, drop_courant, mm_column, lobovsky) and reuses the
 stored runs of the others (the _courant cases: AAP with one global step and per level at five more Courant numbers,
